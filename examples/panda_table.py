@@ -1,0 +1,52 @@
+"""A Panda reaching around a box on a table, planned with stock RRT-Connect (and BalancedRRTConnect when present).
+
+Uses example-robot-data's Panda (``pip install 'ompl-balance[robots]'``): 8 joints, the
+eighth being the finger opening, held at 0.02 m here. Prints time, path length and the
+collision-checking work of each planner. Run: ``python examples/panda_table.py``.
+"""
+
+import time
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+
+from ompl_balance.counting import read_work
+from ompl_balance.robots import load_example_robot_data_panda
+from ompl_balance.validity import CollisionChecker, Environment, setup_robot, space_for
+
+try:
+    from ompl_balance import BalancedRRTConnect
+except ImportError:
+    BalancedRRTConnect = None
+
+robot = load_example_robot_data_panda()
+environment = Environment()
+environment.add_box("table", half_extents=[0.6, 0.8, 0.02], position=[0.5, 0.0, -0.04])  # top 2 cm below the base
+environment.add_box("box", half_extents=[0.05, 0.2, 0.25], position=[0.5, 0.0, 0.25])
+checker = CollisionChecker(robot, environment)
+
+start = np.array([-0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # hand in front, left of the box
+goal = np.array([0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # mirrored, right of the box
+assert checker.check([start, goal]).all(), "start and goal must be collision-free"
+
+planners = [("RRTConnect", og.RRTConnect)]
+if BalancedRRTConnect is not None:
+    planners.append(("BalancedRRTConnect", BalancedRRTConnect))
+for name, make_planner in planners:
+    ss = og.SimpleSetup(space_for(robot))
+    setup_robot(ss, checker)
+    si = ss.getSpaceInformation()
+    s, g = si.allocState(), si.allocState()
+    for i in range(robot.dof):
+        s[i], g[i] = float(start[i]), float(goal[i])
+    ss.setStartAndGoalStates(s, g)
+    ss.setPlanner(make_planner(si))
+    before = read_work(si)
+    began = time.perf_counter()
+    solved = ss.solve(10.0)
+    elapsed = time.perf_counter() - began
+    work = read_work(si) - before
+    length = ss.getSolutionPath().length() if solved else float("nan")
+    print(f"{name:20s} {str(solved.asString() if hasattr(solved, 'asString') else solved):16s} {elapsed:6.2f} s  "
+          f"path length {length:.2f} rad  states checked {work.states_checked}  motions checked {work.motions_checked}")

@@ -1,0 +1,99 @@
+"""Counting the work a planner makes the collision checker do.
+
+Time on a shared machine is noisy; the number of states and motions checked is not.
+Every checker of this package exposes ``counters()`` returning a dict with at least
+
+``states_checked``
+    states whose validity was decided (each call of ``isValid``, and each state a
+    batched motion validator looked at),
+``motions_checked``
+    motions (edges) handed to a motion validator.
+
+A plain Python callable given to ``si.setStateValidityChecker`` counts nothing, so
+:func:`ensure_counting` wraps whatever checker the space information has in a
+:class:`CountingValidityChecker`. Motions checked by OMPL's own
+``DiscreteMotionValidator`` are read from its built-in counter.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from ompl import base as ob
+
+
+class CountingValidityChecker(ob.StateValidityChecker):
+    """A state validity checker that counts the states it is asked about.
+
+    Parameters
+    ----------
+    si:
+        The space information the checker belongs to.
+    check:
+        What decides validity: another ``ob.StateValidityChecker`` (its ``isValid``
+        is called) or a callable ``state -> bool``.
+    """
+
+    def __init__(self, si: ob.SpaceInformation, check: ob.StateValidityChecker | Callable[[ob.State], bool]):
+        super().__init__(si)
+        self._check = check.isValid if isinstance(check, ob.StateValidityChecker) else check
+        self.states_checked = 0
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
+        self.states_checked += 1
+        return bool(self._check(state))
+
+    def counters(self) -> dict[str, int]:
+        """``{"states_checked": n}``: states decided since construction or the last reset."""
+        return {"states_checked": self.states_checked}
+
+    def reset_counters(self) -> None:
+        self.states_checked = 0
+
+
+@dataclass(frozen=True)
+class WorkCount:
+    """States and motions checked, read from a space information's checkers."""
+
+    states_checked: int
+    motions_checked: int
+
+    def __sub__(self, other: WorkCount) -> WorkCount:
+        return WorkCount(self.states_checked - other.states_checked, self.motions_checked - other.motions_checked)
+
+
+def ensure_counting(si: ob.SpaceInformation) -> None:
+    """Make sure ``si``'s state validity checker counts what it checks.
+
+    A checker that already has ``counters()`` (this package's, or a user's that follows
+    the same protocol) is left alone; any other checker, including the wrapper OMPL
+    builds around a plain callable, is wrapped in a :class:`CountingValidityChecker`.
+    Every planner using ``si`` afterwards (stock OMPL planners included) goes through
+    the counting checker, so their counts compare fairly.
+    """
+    checker = si.getStateValidityChecker()
+    if checker is None:
+        raise ValueError("the space information has no state validity checker; call si.setStateValidityChecker first")
+    if not hasattr(checker, "counters"):
+        si.setStateValidityChecker(CountingValidityChecker(si, checker))
+
+
+def read_work(si: ob.SpaceInformation) -> WorkCount:
+    """The work counters of ``si``'s checkers as they stand now.
+
+    Take the difference of two readings to count one run. States checked are ``0``
+    when the checker does not count (see :func:`ensure_counting`). Motions checked
+    come from the motion validator's ``counters()`` when it has them, else from
+    OMPL's own motion counter.
+    """
+    checker = si.getStateValidityChecker()
+    states = checker.counters()["states_checked"] if hasattr(checker, "counters") else 0
+    validator = si.getMotionValidator()
+    if validator is None:
+        motions = 0
+    elif hasattr(validator, "counters"):
+        motions = validator.counters()["motions_checked"]
+    else:
+        motions = validator.getCheckedMotionCount()
+    return WorkCount(states, motions)

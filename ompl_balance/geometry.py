@@ -1,0 +1,164 @@
+"""Collision shapes: one description, three views of it.
+
+A :class:`Shape` is a box, sphere, cylinder or triangle mesh in its own frame (metres).
+The collision layer needs it three ways:
+
+* as an FCL geometry for the exact test (:meth:`Shape.fcl_geometry`; meshes become
+  ``fcl.BVHModel``, primitives FCL's own shapes),
+* as a trimesh mesh (:meth:`Shape.trimesh`), for bounds and for independent checks,
+* as cheap bounding volumes for the numpy pre-filter: a few spheres covering the shape
+  (:meth:`Shape.bounding_spheres`, for robot links) or one oriented box around it
+  (:meth:`Shape.bounding_box`, for obstacles).
+
+Both bounding volumes are conservative for FCL's answer: if they do not touch, FCL
+cannot report a contact. For meshes FCL tests triangles, so covering every triangle
+suffices; for primitives (solids in FCL) the spheres cover the whole solid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import fcl
+import numpy as np
+import trimesh
+
+SHAPE_KINDS = ("box", "sphere", "cylinder", "mesh")
+
+
+@dataclass(frozen=True, eq=False)
+class Shape:
+    """A collision shape in its own frame.
+
+    ``kind`` is one of :data:`SHAPE_KINDS`. ``dims`` holds the sizes in metres:
+    box ``(hx, hy, hz)`` half extents; sphere ``(r,)``; cylinder ``(r, length)`` with the
+    axis along local z and ``length`` the full height, centred on the origin; mesh ``()``
+    with the triangles in ``mesh``.
+    """
+
+    kind: str
+    dims: tuple[float, ...] = ()
+    mesh: trimesh.Trimesh | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        expected = {"box": 3, "sphere": 1, "cylinder": 2, "mesh": 0}
+        if self.kind not in expected:
+            raise ValueError(f"unknown shape kind {self.kind!r}; expected one of {SHAPE_KINDS}")
+        if len(self.dims) != expected[self.kind]:
+            raise ValueError(f"{self.kind} needs {expected[self.kind]} dimensions, got {self.dims}")
+        if not all(np.isfinite(d) and d > 0 for d in self.dims):
+            raise ValueError(f"{self.kind} dimensions must be positive and finite, got {self.dims}")
+        if (self.kind == "mesh") != (self.mesh is not None):
+            raise ValueError("a mesh shape needs a mesh, and only a mesh shape takes one")
+        if self.mesh is not None and len(self.mesh.faces) == 0:
+            raise ValueError("mesh shape has no triangles")
+
+    @staticmethod
+    def box(half_extents) -> Shape:
+        return Shape("box", tuple(float(h) for h in half_extents))
+
+    @staticmethod
+    def sphere(radius: float) -> Shape:
+        return Shape("sphere", (float(radius),))
+
+    @staticmethod
+    def cylinder(radius: float, length: float) -> Shape:
+        return Shape("cylinder", (float(radius), float(length)))
+
+    @staticmethod
+    def from_mesh(mesh: trimesh.Trimesh) -> Shape:
+        return Shape("mesh", (), mesh)
+
+    def fcl_geometry(self) -> fcl.CollisionGeometry:
+        """A new FCL geometry for this shape (BVH model for meshes)."""
+        if self.kind == "box":
+            return fcl.Box(*(2.0 * np.asarray(self.dims)))
+        if self.kind == "sphere":
+            return fcl.Sphere(self.dims[0])
+        if self.kind == "cylinder":
+            return fcl.Cylinder(*self.dims)
+        model = fcl.BVHModel()
+        model.beginModel(len(self.mesh.vertices), len(self.mesh.faces))
+        model.addSubModel(np.asarray(self.mesh.vertices, dtype=float), np.asarray(self.mesh.faces, dtype=np.int32))
+        model.endModel()
+        return model
+
+    def trimesh(self) -> trimesh.Trimesh:
+        """This shape as a triangle mesh (primitives tessellated; cylinders with 64 sides)."""
+        if self.kind == "box":
+            return trimesh.creation.box(extents=2.0 * np.asarray(self.dims))
+        if self.kind == "sphere":
+            return trimesh.creation.icosphere(subdivisions=3, radius=self.dims[0])
+        if self.kind == "cylinder":
+            return trimesh.creation.cylinder(radius=self.dims[0], height=self.dims[1], sections=64)
+        return self.mesh
+
+    def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """An oriented box containing the shape: ``(pose (4, 4) in the shape frame, half extents (3,))``."""
+        if self.kind == "box":
+            return np.eye(4), np.asarray(self.dims)
+        if self.kind == "sphere":
+            return np.eye(4), np.full(3, self.dims[0])
+        if self.kind == "cylinder":
+            r, length = self.dims
+            return np.eye(4), np.array([r, r, 0.5 * length])
+        to_box, extents = trimesh.bounds.oriented_bounds(self.mesh)
+        return np.linalg.inv(to_box), 0.5 * np.asarray(extents)
+
+    def bounding_spheres(self, count: int) -> tuple[np.ndarray, np.ndarray]:
+        """At most ``count`` spheres covering the shape: ``(centres (m, 3), radii (m,))``, shape frame.
+
+        The shape is cut into ``count`` slabs along its longest axis and each slab gets
+        the smallest sphere about the slab's centre that holds it (for meshes: every
+        vertex of the triangles whose centroid falls in the slab, hence every triangle).
+        """
+        if self.kind == "sphere":
+            return np.zeros((1, 3)), np.array([self.dims[0]])
+        if self.kind in ("box", "cylinder"):
+            pose, half = self.bounding_box()
+            axis = int(np.argmax(half))
+            step = 2.0 * half[axis] / count
+            centres = np.zeros((count, 3))
+            centres[:, axis] = -half[axis] + step * (np.arange(count) + 0.5)
+            slab = half.copy()
+            slab[axis] = 0.5 * step  # a cylinder is covered through its bounding box's slabs
+            return centres, np.full(count, np.linalg.norm(slab))
+        triangles = np.asarray(self.mesh.triangles)  # (f, 3, 3)
+        centroids = triangles.mean(axis=1)
+        vertices = triangles.reshape(-1, 3)
+        _, _, axes = np.linalg.svd(vertices - vertices.mean(axis=0), full_matrices=False)
+        along = centroids @ axes[0]
+        edges = np.linspace(along.min(), along.max(), count + 1)
+        slab_of = np.clip(np.searchsorted(edges, along, side="right") - 1, 0, count - 1)
+        centres, radii = [], []
+        for k in np.unique(slab_of):
+            points = triangles[slab_of == k].reshape(-1, 3)
+            centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+            centres.append(centre)
+            radii.append(np.sqrt(((points - centre) ** 2).sum(axis=1).max()))
+        return np.array(centres), np.array(radii)
+
+
+def pose_matrix(position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> np.ndarray:
+    """Homogeneous transform (4, 4) from a position (m) and a unit quaternion, scalar last."""
+    x, y, z, w = (float(v) for v in orientation_xyzw)
+    norm = np.sqrt(x * x + y * y + z * z + w * w)
+    if not np.isfinite(norm) or abs(norm - 1.0) > 1e-3:
+        raise ValueError(f"orientation_xyzw must be a unit quaternion [x, y, z, w], got {list(orientation_xyzw)}")
+    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    pose = np.eye(4)
+    pose[:3, :3] = [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ]
+    position = np.asarray(position, dtype=float)
+    if position.shape != (3,) or not np.all(np.isfinite(position)):
+        raise ValueError(f"position must be 3 finite numbers, got {position.tolist()}")
+    pose[:3, 3] = position
+    return pose
+
+
+def fcl_transform(pose: np.ndarray) -> fcl.Transform:
+    """FCL transform of a (4, 4) homogeneous pose."""
+    return fcl.Transform(pose[:3, :3], pose[:3, 3])

@@ -1,0 +1,300 @@
+"""Robot model from a URDF (+ optional SRDF) and batched forward kinematics in numpy.
+
+The kinematic tree is reduced to *bodies*: the root link and the child frame of every
+moving joint. Links hanging off a body by fixed joints are folded into it as a constant
+offset, and a mimic joint moves with the active joint it follows
+(``multiplier * q + offset``). Forward kinematics therefore costs one small batched
+matrix product per moving joint, for any number of configurations at once.
+
+Configurations are vectors of the *active* joints (revolute, continuous, prismatic;
+not mimic) in :attr:`RobotModel.joint_names` order, radians and metres. Continuous
+joints get the bounds ``[-pi, pi]`` (a real-vector space does not wrap around).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from itertools import combinations
+from pathlib import Path
+from urllib.parse import unquote, urlparse
+
+import numpy as np
+import trimesh
+import yourdfpy
+
+from .geometry import Shape
+
+MOVING_JOINTS = ("revolute", "continuous", "prismatic")
+
+
+@dataclass(frozen=True)
+class LinkGeometry:
+    """One ``<collision>`` element: ``shape`` posed at ``origin`` (4, 4) in its body's frame."""
+
+    link: str
+    body: int
+    origin: np.ndarray
+    shape: Shape
+    source: str | None = None  # the mesh file it was loaded from
+
+
+@dataclass(frozen=True)
+class _MovingJoint:
+    name: str
+    kind: str  # "revolute" (also continuous) or "prismatic"
+    parent_body: int
+    offset: np.ndarray  # (4, 4) parent body frame -> joint frame at q = 0
+    axis: np.ndarray  # (3,) unit, joint frame
+    source: int  # index of the active joint driving it
+    multiplier: float
+    shift: float
+
+
+class RobotModel:
+    """Kinematics, joint limits and collision geometry of a URDF robot.
+
+    Build it with :meth:`from_urdf`. Attributes:
+
+    ``joint_names`` (dof,), ``lower``/``upper`` (dof,) joint bounds; ``link_names``
+    (links,) in the order of :meth:`fk`'s output; ``geometries`` the collision shapes;
+    ``self_collision_pairs`` the geometry index pairs checked for self-collision.
+    """
+
+    def __init__(self, urdf: yourdfpy.URDF, geometries_of, disabled_links: set[frozenset[str]], name: str):
+        robot = urdf.robot
+        joints_by_child = {j.child: j for j in robot.joints}
+        children: dict[str, list] = {}
+        for j in robot.joints:
+            children.setdefault(j.parent, []).append(j)
+        roots = [link.name for link in robot.links if link.name not in joints_by_child]
+        if len(roots) != 1:
+            raise ValueError(f"URDF {name!r} must form one tree with a single root link, found roots {roots}")
+
+        active = [j for j in robot.joints if j.type in MOVING_JOINTS and j.mimic is None]
+        self.name = name
+        self.joint_names: list[str] = [j.name for j in active]
+        bounds = np.array([_limits(j) for j in active]).reshape(-1, 2)
+        self.lower, self.upper = bounds[:, 0], bounds[:, 1]
+        active_index = {n: i for i, n in enumerate(self.joint_names)}
+
+        # walk the tree depth-first from the root: bodies, moving joints, folded offsets
+        self.link_names: list[str] = []
+        link_body: list[int] = []
+        link_offset: list[np.ndarray] = []
+        self._joints: list[_MovingJoint] = []
+        body_parent = [-1]
+        stack = [(roots[0], 0, np.eye(4))]
+        while stack:
+            link, body, offset = stack.pop()
+            self.link_names.append(link)
+            link_body.append(body)
+            link_offset.append(offset)
+            for j in reversed(children.get(link, [])):
+                origin = offset @ (np.eye(4) if j.origin is None else j.origin)
+                if j.type == "fixed":
+                    stack.append((j.child, body, origin))
+                    continue
+                if j.type not in MOVING_JOINTS:
+                    raise ValueError(f"joint {j.name!r} has unsupported type {j.type!r} (supported: fixed, {', '.join(MOVING_JOINTS)})")
+                driver, mult, shift = j.name, 1.0, 0.0
+                if j.mimic is not None:
+                    driver = j.mimic.joint
+                    mult = 1.0 if j.mimic.multiplier is None else float(j.mimic.multiplier)
+                    shift = 0.0 if j.mimic.offset is None else float(j.mimic.offset)
+                    if driver not in active_index:
+                        raise ValueError(f"mimic joint {j.name!r} follows {driver!r}, which is not an active joint")
+                axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, dtype=float)
+                self._joints.append(_MovingJoint(
+                    j.name, "prismatic" if j.type == "prismatic" else "revolute", body, origin,
+                    axis / np.linalg.norm(axis), active_index[driver], mult, shift))
+                body_parent.append(body)
+                stack.append((j.child, len(self._joints), np.eye(4)))
+        joints = self._joints
+        self._source = np.array([j.source for j in joints], dtype=int)
+        self._multiplier = np.array([j.multiplier for j in joints])
+        self._shift = np.array([j.shift for j in joints])
+        self._offset = np.array([j.offset for j in joints]).reshape(-1, 4, 4)
+        self._axis = np.array([j.axis for j in joints]).reshape(-1, 3)
+        self._parent_body = [j.parent_body for j in joints]
+        self._revolute = np.array([j.kind == "revolute" for j in joints], dtype=float)[:, None, None]
+        self._prismatic = np.array([j.kind == "prismatic" for j in joints], dtype=float)[:, None]
+        # Rodrigues: R = I + sin(a) K + (1 - cos(a)) K^2 with K the cross-product matrix of the axis
+        x, y, z = self._axis.T
+        zero = np.zeros_like(x)
+        self._cross = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1).reshape(-1, 3, 3)
+        self._cross2 = self._cross @ self._cross
+        self._link_body = np.array(link_body)
+        self._link_offset = np.array(link_offset)
+        self.link_index = {n: i for i, n in enumerate(self.link_names)}
+
+        self.geometries: list[LinkGeometry] = []
+        for link in robot.links:
+            body, offset = link_body[self.link_index[link.name]], link_offset[self.link_index[link.name]]
+            for origin, shape, source in geometries_of(link):
+                self.geometries.append(LinkGeometry(link.name, body, offset @ origin, shape, source))
+
+        # self-collision: geometry pairs on different links, not disabled by the SRDF and
+        # not adjacent (same body, or bodies joined by one moving joint)
+        unknown = {n for pair in disabled_links for n in pair} - set(self.link_index)
+        if unknown:
+            raise ValueError(f"SRDF disable_collisions names links not in the URDF: {sorted(unknown)}")
+        self.self_collision_pairs: list[tuple[int, int]] = []
+        for a, b in combinations(range(len(self.geometries)), 2):
+            ga, gb = self.geometries[a], self.geometries[b]
+            adjacent = ga.body == gb.body or body_parent[ga.body] == gb.body or body_parent[gb.body] == ga.body
+            if ga.link != gb.link and not adjacent and frozenset((ga.link, gb.link)) not in disabled_links:
+                self.self_collision_pairs.append((a, b))
+
+    @property
+    def dof(self) -> int:
+        return len(self.joint_names)
+
+    @property
+    def body_count(self) -> int:
+        """Number of rigid bodies: the root plus one per moving joint (mimic ones included)."""
+        return len(self._joints) + 1
+
+    @staticmethod
+    def from_urdf(urdf_path, srdf_path=None, package_map: dict[str, str] | None = None) -> RobotModel:
+        """Load a robot from a URDF file and, optionally, its MoveIt SRDF.
+
+        ``package_map`` maps ROS package names to directories for ``package://NAME/...``
+        mesh paths. Without an entry, ``NAME/...`` is looked for beside the URDF and in
+        its parent directories, and a parent directory called ``NAME`` is taken as the
+        package. Only ``<collision>`` elements are read; ``<visual>`` is ignored.
+        """
+        urdf_path = Path(urdf_path)
+        if not urdf_path.is_file():
+            raise FileNotFoundError(f"URDF file not found: {urdf_path}")
+        try:
+            urdf = yourdfpy.URDF.load(str(urdf_path), build_scene_graph=False, load_meshes=False,
+                                      build_collision_scene_graph=False, load_collision_meshes=False)
+        except Exception as error:  # yourdfpy raises many types for broken files
+            raise ValueError(f"cannot parse URDF {urdf_path}: {error}") from error
+        if urdf.robot is None or not urdf.robot.links:
+            raise ValueError(f"cannot parse URDF {urdf_path}: no <robot> with links")
+        resolve = _MeshResolver(urdf_path.parent, package_map or {})
+        disabled = _srdf_disabled_pairs(Path(srdf_path)) if srdf_path is not None else set()
+        return RobotModel(urdf, lambda link: _link_shapes(link, resolve), disabled, urdf.robot.name)
+
+    def as_array(self, q) -> np.ndarray:
+        """``q`` as a float array (n, dof); raises ``ValueError`` for a wrong shape or non-finite values."""
+        q = np.asarray(q, dtype=float)
+        q2 = q.reshape(1, -1) if q.ndim == 1 else q
+        if q2.ndim != 2 or q2.shape[1] != self.dof:
+            raise ValueError(f"configurations must have shape (n, {self.dof}) for joints {self.joint_names}, got {q.shape}")
+        bad = ~np.isfinite(q2)
+        if bad.any():
+            row, col = np.argwhere(bad)[0]
+            raise ValueError(f"configuration {row} has non-finite value {q2[row, col]} for joint {self.joint_names[col]!r}")
+        return q2
+
+    def body_poses(self, q) -> np.ndarray:
+        """World poses of the bodies, (n, bodies, 4, 4), for configurations ``q`` (n, dof)."""
+        q = self.as_array(q)
+        values = q[:, self._source] * self._multiplier + self._shift  # (n, moving joints)
+        # each moving joint's transform parent body -> child body: offset @ motion(value)
+        motion = np.broadcast_to(np.eye(4), values.shape + (4, 4)).copy()
+        s, c = np.sin(values)[..., None, None], np.cos(values)[..., None, None]
+        motion[..., :3, :3] += self._revolute * (s * self._cross + (1.0 - c) * self._cross2)
+        motion[..., :3, 3] += self._prismatic * values[..., None] * self._axis
+        local = self._offset @ motion
+        poses = np.empty((len(q), self.body_count, 4, 4))
+        poses[:, 0] = np.eye(4)
+        for k, parent in enumerate(self._parent_body, start=1):
+            poses[:, k] = poses[:, parent] @ local[:, k - 1]
+        return poses
+
+    def fk(self, q) -> np.ndarray:
+        """World poses of all links, (n, links, 4, 4), in :attr:`link_names` order.
+
+        ``q`` is (n, dof) or (dof,) in :attr:`joint_names` order; the root link is the world frame.
+        """
+        return self.body_poses(q)[:, self._link_body] @ self._link_offset
+
+
+def _limits(joint) -> tuple[float, float]:
+    if joint.type == "continuous":
+        return -np.pi, np.pi
+    limit = joint.limit
+    if limit is None or limit.lower is None or limit.upper is None:
+        raise ValueError(f"joint {joint.name!r} ({joint.type}) has no <limit lower upper>")
+    if not limit.lower <= limit.upper:
+        raise ValueError(f"joint {joint.name!r} has lower limit {limit.lower} above upper limit {limit.upper}")
+    return float(limit.lower), float(limit.upper)
+
+
+class _MeshResolver:
+    """Maps URDF mesh file names (``package://``, ``file://``, relative, absolute) to existing files."""
+
+    def __init__(self, urdf_dir: Path, package_map: dict[str, str]):
+        self.urdf_dir = urdf_dir.resolve()
+        self.package_map = {k: Path(v) for k, v in package_map.items()}
+
+    def candidates(self, filename: str) -> list[Path]:
+        if filename.startswith("package://"):
+            package, _, rest = filename[len("package://"):].partition("/")
+            found = [self.package_map[package] / rest] if package in self.package_map else []
+            for folder in (self.urdf_dir, *self.urdf_dir.parents):
+                found.append(folder / package / rest)
+                if folder.name == package:
+                    found.append(folder / rest)
+            return found
+        if filename.startswith("file://"):
+            return [Path(unquote(urlparse(filename).path))]
+        return [self.urdf_dir / filename]
+
+    def __call__(self, filename: str, link: str) -> Path:
+        tried = self.candidates(filename)
+        for path in tried:
+            if path.is_file():
+                return path
+        raise FileNotFoundError(
+            f"link {link!r}: collision mesh {filename!r} not found (tried {', '.join(map(str, tried[:4]))}"
+            f"{', ...' if len(tried) > 4 else ''}); pass package_map={{'PACKAGE': '/path/to/package'}}")
+
+
+def _link_shapes(link, resolve: _MeshResolver):
+    """``(origin (4, 4), Shape, source file or None)`` for each ``<collision>`` of a yourdfpy link."""
+    for collision in link.collisions:
+        origin = np.eye(4) if collision.origin is None else np.asarray(collision.origin, dtype=float)
+        geometry = collision.geometry
+        if geometry is None:
+            raise ValueError(f"link {link.name!r}: <collision> without <geometry>")
+        if geometry.box is not None:
+            yield origin, Shape.box(0.5 * np.asarray(geometry.box.size, dtype=float)), None
+        elif geometry.sphere is not None:
+            yield origin, Shape.sphere(geometry.sphere.radius), None
+        elif geometry.cylinder is not None:
+            yield origin, Shape.cylinder(geometry.cylinder.radius, geometry.cylinder.length), None
+        elif geometry.mesh is not None:
+            path = resolve(geometry.mesh.filename, link.name)
+            try:
+                mesh = trimesh.load(str(path), force="mesh")
+            except Exception as error:
+                raise ValueError(f"link {link.name!r}: cannot read collision mesh {path}: {error}") from error
+            if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+                raise ValueError(f"link {link.name!r}: collision mesh {path} holds no triangles")
+            if geometry.mesh.scale is not None:
+                mesh.apply_scale(geometry.mesh.scale)
+            yield origin, Shape.from_mesh(mesh), str(path)
+        else:
+            raise ValueError(f"link {link.name!r}: unsupported collision geometry (supported: box, sphere, cylinder, mesh)")
+
+
+def _srdf_disabled_pairs(srdf_path: Path) -> set[frozenset[str]]:
+    """Link pairs of the SRDF's ``<disable_collisions link1 link2>`` elements."""
+    if not srdf_path.is_file():
+        raise FileNotFoundError(f"SRDF file not found: {srdf_path}")
+    try:
+        root = ET.parse(srdf_path).getroot()
+    except ET.ParseError as error:
+        raise ValueError(f"cannot parse SRDF {srdf_path}: {error}") from error
+    pairs = set()
+    for element in root.iter("disable_collisions"):
+        a, b = element.get("link1"), element.get("link2")
+        if not a or not b:
+            raise ValueError(f"SRDF {srdf_path}: <disable_collisions> needs link1 and link2, got {element.attrib}")
+        pairs.add(frozenset((a, b)))
+    return pairs

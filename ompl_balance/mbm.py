@@ -1,0 +1,88 @@
+"""MotionBenchMaker problems in the neutral JSON form (schema ``mbm-neutral-v1``).
+
+One file per scenario: joint names, and per problem a start, one or more goals
+(any goal is a success) and the obstacles (boxes with half extents, cylinders along
+local z with full length, spheres; world frame = robot base). The problems were made
+for VAMP's Panda model (:func:`ompl_balance.robots.load_panda_vamp`).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .validity import Environment
+
+
+@dataclass(frozen=True)
+class MBMProblem:
+    """One problem: ``start`` (dof,) and ``goals`` (k, dof) in rad, ordered as the loader's joint names."""
+
+    scenario: str
+    id: int
+    start: np.ndarray
+    goals: np.ndarray
+    environment: Environment
+    valid: bool  # the file's flag: start and a goal collision-free under VAMP's sphere model
+
+
+def load_mbm(path, joint_names: list[str] | None = None) -> list[MBMProblem]:
+    """Read a scenario file; configurations reordered to ``joint_names`` (default: the file's order).
+
+    Raises ``ValueError`` naming the file, problem and field for anything missing or malformed,
+    and for joint names the file and ``joint_names`` do not share.
+    """
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as error:
+        raise ValueError(f"cannot read MotionBenchMaker file {path}: {error}") from error
+    file_joints = _field(data, "joint_names", path)
+    joint_names = list(file_joints) if joint_names is None else list(joint_names)
+    unknown = sorted(set(file_joints) ^ set(joint_names))
+    if unknown:
+        raise ValueError(f"{path}: joint names {unknown} are not in both the file {file_joints} and the robot {joint_names}")
+    column = [file_joints.index(name) for name in joint_names]
+    scenario = str(data.get("scenario", path.stem))
+    return [_problem(p, scenario, column, f"{path} problem {p.get('id', i) if isinstance(p, dict) else i}")
+            for i, p in enumerate(_field(data, "problems", path))]
+
+
+def _field(record, name: str, where):
+    if not isinstance(record, dict) or name not in record:
+        raise ValueError(f"{where}: missing field {name!r}")
+    return record[name]
+
+
+def _configurations(values, width: int, where: str) -> np.ndarray:
+    array = np.asarray(values, dtype=float)
+    if array.ndim != 2 or array.shape[1] != width or not np.all(np.isfinite(array)):
+        raise ValueError(f"{where}: expected finite configurations of {width} joint values, got {values!r}")
+    return array
+
+
+def _problem(record, scenario: str, column: list[int], where: str) -> MBMProblem:
+    start = _configurations([_field(record, "start", where)], len(column), f"{where} start")[0, column]
+    goals = _configurations(_field(record, "goals", where), len(column), f"{where} goals")[:, column]
+    environment = Environment()
+    for index, obstacle in enumerate(_field(record, "obstacles", where)):
+        name = str(obstacle.get("name", f"obstacle{index}")) if isinstance(obstacle, dict) else f"obstacle{index}"
+        at = f"{where} obstacle {name!r}"
+        kind = _field(obstacle, "type", at)
+        pose = (_field(obstacle, "position", at), _field(obstacle, "orientation_xyzw", at))
+        try:
+            if kind == "box":
+                environment.add_box(name, _field(obstacle, "half_extents", at), *pose)
+            elif kind == "cylinder":
+                environment.add_cylinder(name, _field(obstacle, "radius", at), _field(obstacle, "length", at), *pose)
+            elif kind == "sphere":
+                environment.add_sphere(name, _field(obstacle, "radius", at), pose[0])
+            else:
+                raise ValueError(f"unknown obstacle type {kind!r} (box, cylinder, sphere)")
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"{at}: {error}") from error
+    return MBMProblem(scenario, int(_field(record, "id", where)), start, goals, environment,
+                      bool(record.get("valid", True)))

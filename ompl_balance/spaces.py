@@ -1,0 +1,146 @@
+"""How the planners see a state space: sampling, distance, interpolation, conversion.
+
+A planner works on "points" and asks this layer everything it needs to know about
+them. Two implementations share one interface:
+
+:class:`RealVectorPoints`
+    for ``ob.RealVectorStateSpace``: points are numpy arrays of shape ``(dim,)``,
+    sampled uniformly within the bounds from a numpy generator, with Euclidean
+    distance and straight-line interpolation (what OMPL's real-vector space does);
+    trees are :class:`~ompl_balance.trees.ArrayTree`.
+:class:`StatePoints`
+    for every other OMPL space (SO2, SE2, SE3, compound, ...): points are OMPL states,
+    and every question goes to OMPL (``si.distance``, ``space.interpolate``, the
+    space's default sampler); trees are :class:`~ompl_balance.trees.StateTree`.
+
+Collision checking is never done here: planners pass ``ompl_state(point)`` to
+``si.isValid`` / ``si.checkMotion`` so that stock OMPL planners and ours use exactly the
+same checker and motion validator.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from ompl import base as ob
+
+from .trees import ArrayTree, StateTree
+
+_SAMPLE_BLOCK = 256  # uniform samples drawn from numpy at a time
+
+
+class RealVectorPoints:
+    """Points of an ``ob.RealVectorStateSpace`` as ``(dim,)`` float64 arrays."""
+
+    def __init__(self, si: ob.SpaceInformation, rng: np.random.Generator) -> None:
+        space = si.getStateSpace()
+        self.dim = space.getDimension()
+        bounds = space.getBounds()
+        self.low = np.array(bounds.low, dtype=float)
+        self.high = np.array(bounds.high, dtype=float)
+        self._rng = rng
+        self._block = np.empty((0, self.dim))
+        self._next = 0
+        self._space = space
+        self._si = si
+        # Two scratch OMPL states: checks take a pair (nearest, new) at a time.
+        self._scratch = (si.allocState(), si.allocState())
+
+    def new_tree(self) -> ArrayTree:
+        return ArrayTree(self.dim)
+
+    def sample(self) -> np.ndarray:
+        """A uniform sample within the bounds, ``(dim,)``."""
+        if self._next == len(self._block):
+            self._block = self._rng.uniform(self.low, self.high, size=(_SAMPLE_BLOCK, self.dim))
+            self._next = 0
+        point = self._block[self._next]
+        self._next += 1
+        return point
+
+    @staticmethod
+    def distance(a: np.ndarray, b: np.ndarray) -> float:
+        offset = b - a
+        return math.sqrt(offset @ offset)
+
+    @staticmethod
+    def interpolate(a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
+        """The point a fraction ``t`` of the way from ``a`` to ``b``."""
+        return a + t * (b - a)
+
+    @staticmethod
+    def equal(a: np.ndarray, b: np.ndarray) -> bool:
+        # OMPL's RealVectorStateSpace::equalStates tolerance
+        return bool(np.all(np.abs(a - b) <= 2.0 * np.finfo(float).eps))
+
+    def from_state(self, state: ob.State) -> np.ndarray:
+        """A copy of an OMPL state's values, ``(dim,)``."""
+        return np.array(state[0 : self.dim], dtype=float)
+
+    def ompl_state(self, point: np.ndarray, slot: int = 0) -> ob.State:
+        """``point`` written into scratch OMPL state ``slot`` (0 or 1); valid until reused."""
+        state = self._scratch[slot]
+        self._space.copyFromReals(state, point.tolist())
+        return state
+
+    def new_state(self, point: np.ndarray) -> ob.State:
+        """A freshly allocated OMPL state holding ``point`` (for output)."""
+        state = self._si.allocState()
+        self._space.copyFromReals(state, point.tolist())
+        return state
+
+    def segment_points(self, a: np.ndarray, b: np.ndarray) -> list[np.ndarray]:
+        """Points after ``a`` up to and including ``b`` at the space's resolution.
+
+        The same states ``si.getMotionStates`` yields for ``validSegmentCount(a, b)``.
+        """
+        count = self._space.validSegmentCount(self.ompl_state(a, 0), self.ompl_state(b, 1)) + 1
+        return [self.interpolate(a, b, step / count) for step in range(1, count)] + [b]
+
+
+class StatePoints:
+    """Points of any OMPL state space, as OMPL states owned by the caller."""
+
+    def __init__(self, si: ob.SpaceInformation) -> None:
+        self._si = si
+        self._space = si.getStateSpace()
+        self._sampler = si.allocStateSampler()
+        self.distance = si.distance
+        self.equal = si.equalStates
+
+    def new_tree(self) -> StateTree:
+        return StateTree(self._si)
+
+    def sample(self) -> ob.State:
+        state = self._si.allocState()
+        self._sampler.sampleUniform(state)
+        return state
+
+    def interpolate(self, a: ob.State, b: ob.State, t: float) -> ob.State:
+        state = self._si.allocState()
+        self._space.interpolate(a, b, t, state)
+        return state
+
+    def from_state(self, state: ob.State) -> ob.State:
+        return self.new_state(state)
+
+    def new_state(self, point: ob.State) -> ob.State:
+        state = self._si.allocState()
+        self._si.copyState(state, point)
+        return state
+
+    @staticmethod
+    def ompl_state(point: ob.State, slot: int = 0) -> ob.State:
+        return point
+
+    def segment_points(self, a: ob.State, b: ob.State) -> list[ob.State]:
+        count = self._space.validSegmentCount(a, b) + 1
+        return [self.interpolate(a, b, step / count) for step in range(1, count)] + [self.new_state(b)]
+
+
+def points_for(si: ob.SpaceInformation, rng: np.random.Generator) -> RealVectorPoints | StatePoints:
+    """The fast array view for plain real-vector spaces, OMPL states otherwise."""
+    if type(si.getStateSpace()) is ob.RealVectorStateSpace:
+        return RealVectorPoints(si, rng)
+    return StatePoints(si)

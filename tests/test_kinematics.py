@@ -1,0 +1,113 @@
+"""Robot model and batched forward kinematics against yourdfpy."""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yourdfpy
+
+from ompl_balance.kinematics import RobotModel
+
+ROBOTS = Path(__file__).resolve().parent / "robots"
+PANDA_VAMP = Path(__file__).resolve().parents[2] / "shared" / "data" / "robots" / "panda_vamp"
+
+
+def load_arm3():
+    return RobotModel.from_urdf(ROBOTS / "arm3.urdf", ROBOTS / "arm3.srdf", package_map={"testbot": str(ROBOTS)})
+
+
+def assert_fk_matches_yourdfpy(robot, urdf_path, root, count=40, seed=0):
+    urdf = yourdfpy.URDF.load(str(urdf_path), load_meshes=False, build_collision_scene_graph=False)
+    q = np.random.default_rng(seed).uniform(robot.lower, robot.upper, size=(count, robot.dof))
+    poses = robot.fk(q)
+    assert poses.shape == (count, len(robot.link_names), 4, 4)
+    for i in range(count):
+        urdf.update_cfg(dict(zip(robot.joint_names, q[i])))
+        for k, link in enumerate(robot.link_names):
+            np.testing.assert_allclose(poses[i, k], urdf.get_transform(link, root), atol=1e-9, rtol=0)
+
+
+def test_arm3_model():
+    robot = load_arm3()
+    assert robot.joint_names == ["turn", "shoulder", "slide"]  # the mimic finger is not a joint of the space
+    np.testing.assert_allclose(robot.lower, [-np.pi, -2.6, 0.0])
+    np.testing.assert_allclose(robot.upper, [np.pi, 2.6, 0.2])
+    assert robot.body_count == 5  # root, three active joints, the mimic joint; fixed flange and tool folded in
+    names = [(robot.geometries[a].link, robot.geometries[b].link) for a, b in robot.self_collision_pairs]
+    # base-boom disabled by the SRDF; adjacent bodies and the rigid slider/flange/tool group skipped
+    assert set(names) == {("base", "slider"), ("base", "tool"), ("base", "finger"), ("column", "slider"),
+                          ("column", "tool"), ("column", "finger"), ("boom", "finger")}
+
+
+def test_fk_matches_yourdfpy_arm3():
+    assert_fk_matches_yourdfpy(load_arm3(), ROBOTS / "arm3.urdf", "base")
+
+
+def test_fk_single_configuration_and_batch_agree():
+    robot = load_arm3()
+    q = np.random.default_rng(3).uniform(robot.lower, robot.upper, size=(7, robot.dof))
+    np.testing.assert_array_equal(robot.fk(q)[2], robot.fk(q[2])[0])
+
+
+@pytest.mark.skipif(not PANDA_VAMP.is_dir(), reason=f"shared data not found at {PANDA_VAMP}")
+def test_fk_matches_yourdfpy_panda_vamp():
+    robot = RobotModel.from_urdf(PANDA_VAMP / "panda.urdf", PANDA_VAMP / "panda.srdf")
+    assert robot.dof == 7 and len(robot.geometries) == 11
+    assert_fk_matches_yourdfpy(robot, PANDA_VAMP / "panda.urdf", "panda_link0")
+
+
+def test_fk_matches_yourdfpy_example_robot_data_panda():
+    robots = pytest.importorskip("ompl_balance.robots")
+    try:
+        robot = robots.load_example_robot_data_panda()
+    except ImportError as error:
+        pytest.skip(str(error))
+    assert robot.joint_names[-1] == "panda_finger_joint1" and robot.dof == 8  # finger_joint2 mimics it
+    urdf = robots.example_robot_data_dir() / "robots" / "panda_description" / "urdf" / "panda.urdf"
+    assert_fk_matches_yourdfpy(robot, urdf, "panda_link0", count=20)
+
+
+def test_package_resolved_from_parent_folder_named_like_the_package(tmp_path):
+    package = tmp_path / "testbot"
+    shutil.copytree(ROBOTS, package)
+    robot = RobotModel.from_urdf(package / "arm3.urdf")  # no package map: folder name matches
+    assert sum(g.source is not None for g in robot.geometries) == 2
+
+
+def test_missing_mesh_names_file_and_link(tmp_path):
+    shutil.copy(ROBOTS / "arm3.urdf", tmp_path / "arm3.urdf")
+    with pytest.raises(FileNotFoundError, match=r"link 'boom'.*package://testbot/meshes/cone.obj"):
+        RobotModel.from_urdf(tmp_path / "arm3.urdf")
+
+
+def test_unreadable_mesh_names_file_and_link(tmp_path):
+    shutil.copy(ROBOTS / "arm3.urdf", tmp_path / "arm3.urdf")
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "cone.obj").write_text("this is not a mesh\n")
+    with pytest.raises((ValueError, FileNotFoundError), match="link '(boom|slider)'"):
+        RobotModel.from_urdf(tmp_path / "arm3.urdf", package_map={"testbot": str(tmp_path)})
+
+
+def test_urdf_that_does_not_parse(tmp_path):
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'><parent link='a'/>")
+    with pytest.raises(ValueError, match="bad.urdf"):
+        RobotModel.from_urdf(bad)
+    with pytest.raises(FileNotFoundError, match="nowhere.urdf"):
+        RobotModel.from_urdf(tmp_path / "nowhere.urdf")
+
+
+def test_srdf_naming_unknown_link(tmp_path):
+    srdf = tmp_path / "x.srdf"
+    srdf.write_text('<robot name="arm3"><disable_collisions link1="base" link2="wing"/></robot>')
+    with pytest.raises(ValueError, match="wing"):
+        RobotModel.from_urdf(ROBOTS / "arm3.urdf", srdf, package_map={"testbot": str(ROBOTS)})
+
+
+def test_bad_configurations():
+    robot = load_arm3()
+    with pytest.raises(ValueError, match="'shoulder'"):
+        robot.fk([[0.0, np.nan, 0.1]])
+    with pytest.raises(ValueError, match=r"\(n, 3\)"):
+        robot.fk(np.zeros((2, 4)))

@@ -1,0 +1,420 @@
+"""BalancedRRTConnect: the balancing rule, drop-in behaviour, statuses, seeds, planner data."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import tools as ot
+from ompl import util as ou
+
+from ompl_balance import BalancedRRTConnect, balance_choice, read_work, tree_size_ratio
+from ompl_balance.problems import PROBLEMS, BoxWorld2D, get_problem
+from pathcheck import assert_valid_solution
+
+ou.setLogLevel(ou.LOG_WARN)
+REPO = Path(__file__).resolve().parents[1]
+
+
+# -- the balancing rule --------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("start_size", "goal_size", "balance", "max_ratio", "expected"),
+    [
+        (10, 10, True, 1.0, None),  # equal trees: alternate
+        (10, 19, True, 1.0, None),  # ratio 0.9 < 1: alternate
+        (10, 20, True, 1.0, True),  # ratio 1.0: grow the smaller start tree
+        (20, 10, True, 1.0, False),  # ...or the smaller goal tree
+        (1, 100, True, 1.0, True),  # ratio 99
+        (1, 100, False, 1.0, None),  # balancing off: always alternate
+        (10, 12, True, 0.0, True),  # ratio 0 engages on any difference
+        (10, 10, True, 0.0, None),
+        (10, 14, True, 0.5, None),  # ratio 0.4 < 0.5
+        (10, 15, True, 0.5, True),
+        (100, 1000, True, 10.0, None),  # ratio 9 < 10
+        (100, 1100, True, 10.0, True),
+    ],
+)
+def test_balance_rule_table(start_size, goal_size, balance, max_ratio, expected):
+    assert balance_choice(start_size, goal_size, balance, max_ratio) is expected
+
+
+def test_ratio_divides_by_the_smaller_tree():
+    assert tree_size_ratio(10, 30) == pytest.approx(2.0)
+    assert tree_size_ratio(30, 10) == pytest.approx(2.0)
+    assert tree_size_ratio(7, 7) == 0.0
+
+
+def test_dividing_by_the_larger_tree_never_engages_at_the_default_ratio():
+    """The first OMPL pull request divided by max(a, b): below 1 for every pair of sizes."""
+    default_ratio = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation()).getMaxTreeSizeRatio()
+    assert default_ratio == 1.0
+    pairs = [(a, b) for a in range(1, 200) for b in (1, 2, 5, 50, 10_000)]
+    assert all(abs(a - b) / max(a, b) < default_ratio for a, b in pairs)
+    engaged = [balance_choice(a, b, True, default_ratio) for a, b in pairs]
+    assert any(choice is not None for choice in engaged)
+    # ours engages exactly when the larger tree is at least twice the smaller
+    assert all((choice is not None) == (max(a, b) >= 2 * min(a, b)) for (a, b), choice in zip(pairs, engaged))
+
+
+def test_balancing_grows_the_smaller_tree_during_a_run():
+    """On the bug trap the start tree is trapped; balanced runs keep the trees within the ratio."""
+    ss = get_problem("bug_trap").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setMaxTreeSizeRatio(1.0)
+    ss.setPlanner(planner)
+    assert ss.solve(5.0)
+    stats = planner.stats
+    small, large = sorted((stats.start_tree_size, stats.goal_tree_size))
+    # The smaller tree is grown whenever the larger reaches twice its size; one connect
+    # step can overshoot by the nodes of a single extension chain.
+    assert large <= 2 * small + 10
+
+
+# -- drop-in through SimpleSetup ----------------------------------------------------------
+
+
+def solve_problem(name: str, planner_setup=None, time_limit: float = 5.0):
+    problem = get_problem(name)
+    ss = problem.setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    if planner_setup:
+        planner_setup(planner)
+    ss.setPlanner(planner)
+    status = ss.solve(time_limit)
+    return problem, ss, planner, status
+
+
+def start_states(problem, ss):
+    """The problem's start as an OMPL state of our own.
+
+    (``pdef.getStartState(i)`` is not used: in OMPL 2.0.1's bindings the state it
+    returns is freed twice at garbage collection, crashing the process.)
+    """
+    state = ss.getSpaceInformation().allocState()
+    state[0], state[1] = problem.start
+    return [state]
+
+
+def goal_test_for(ss):
+    goal = ss.getGoal()
+    return lambda state: goal.isSatisfied(state)
+
+
+@pytest.mark.parametrize("name", list(PROBLEMS))
+@pytest.mark.parametrize("balance", [True, False])
+def test_solves_builtin_problems_with_valid_paths(name, balance):
+    problem, ss, planner, status = solve_problem(name, lambda p: p.setBalanceTreeSizes(balance))
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert_valid_solution(ss, problem.world(), start_states(problem, ss), goal_test_for(ss))
+
+
+def test_intermediate_states_paths_are_valid():
+    problem, ss, planner, status = solve_problem("narrow_gap", lambda p: p.setIntermediateStates(True))
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    path = assert_valid_solution(ss, problem.world(), start_states(problem, ss), goal_test_for(ss))
+    # with intermediate states no step is longer than the checking resolution
+    si = ss.getSpaceInformation()
+    longest = si.getStateSpace().getLongestValidSegmentLength()
+    states = [path.getState(i) for i in range(path.getStateCount())]
+    assert max(si.distance(a, b) for a, b in zip(states, states[1:])) <= longest + 1e-9
+
+
+def boxes_7d():
+    """A 7-D unit cube with two slabs to get around; returns (is_valid, start, goal values)."""
+
+    def is_free(values):
+        in_slab_1 = 0.3 <= values[0] <= 0.4 and values[1] < 0.8
+        in_slab_2 = 0.6 <= values[0] <= 0.7 and values[1] > 0.2
+        return not (in_slab_1 or in_slab_2)
+
+    return is_free, [0.1] * 7, [0.9] * 7
+
+
+def test_solves_7d_real_vector_space():
+    is_free, start_values, goal_values = boxes_7d()
+    space = ob.RealVectorStateSpace(7)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    is_valid = lambda state: is_free([state[i] for i in range(7)])  # noqa: E731
+    ss.setStateValidityChecker(is_valid)
+    start, goal = space.allocState(), space.allocState()
+    for i in range(7):
+        start[i], goal[i] = start_values[i], goal_values[i]
+    ss.setStartAndGoalStates(start, goal)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert_valid_solution(ss, is_valid, [start], goal_test_for(ss))
+    assert planner.stats.states_checked > 0  # the plain callable was wrapped in a counter
+
+
+def se2_world():
+    world = BoxWorld2D(get_problem("narrow_gap").boxes)
+    return lambda state: world.is_free(state.getX(), state.getY())
+
+
+def make_se2_setup():
+    space = ob.SE2StateSpace()
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0.0)
+    bounds.setHigh(1.0)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    is_valid = se2_world()
+    ss.setStateValidityChecker(is_valid)
+    ss.getSpaceInformation().setStateValidityCheckingResolution(0.005)
+    start, goal = space.allocState(), space.allocState()
+    start.setX(0.1), start.setY(0.5), start.setYaw(0.0)
+    goal.setX(0.9), goal.setY(0.5), goal.setYaw(math.pi / 2)
+    ss.setStartAndGoalStates(start, goal)
+    return ss, is_valid, start
+
+
+def test_solves_se2_through_ompl_states():
+    ss, is_valid, start = make_se2_setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert_valid_solution(ss, is_valid, [start], goal_test_for(ss))
+    data = planner.plannerData()
+    assert data.numVertices() == planner.stats.start_tree_size + planner.stats.goal_tree_size
+
+
+def test_solve_called_directly_with_seconds():
+    problem = get_problem("narrow_gap")
+    ss = problem.setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setProblemDefinition(ss.getProblemDefinition())
+    planner.setup()
+    status = planner.solve(1.0)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    pdef = ss.getProblemDefinition()
+    assert pdef.getSolutionPath().getStateCount() >= 2
+
+
+@pytest.mark.parametrize("bad", [0, -1.0, float("nan"), float("inf")])
+def test_solve_rejects_time_limits_that_are_not_positive(bad):
+    ss = get_problem("open").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setProblemDefinition(ss.getProblemDefinition())
+    with pytest.raises(ValueError, match="positive"):
+        planner.solve(bad)
+
+
+def test_ompl_benchmark_runs_and_logs_our_planner(tmp_path):
+    ss = get_problem("narrow_gap").setup()
+    si = ss.getSpaceInformation()
+    benchmark = ot.Benchmark(ss, "dropin")
+    benchmark.addPlanner(og.RRTConnect(si))
+    benchmark.addPlanner(BalancedRRTConnect(si))
+    benchmark.benchmark(ot.Request(2.0, 1024.0, 3, 0.05, False, False, False))
+    log = tmp_path / "dropin.log"
+    assert benchmark.saveResultsToFile(str(log))
+    text = log.read_text()
+    assert "geometric_BalancedRRTConnect" in text
+    planners = {p.name: p for p in benchmark.getRecordedExperimentData().planners}
+    runs = planners["geometric_BalancedRRTConnect"].runs
+    assert len(runs) == 3
+    assert all(run.to_dict()["solved BOOLEAN"] == "1" for run in runs)
+
+
+def test_simple_setup_get_planner_data_does_not_crash_and_plannerdata_has_both_trees():
+    problem, ss, planner, status = solve_problem("bug_trap")
+    data = ob.PlannerData(ss.getSpaceInformation())
+    ss.getPlannerData(data)  # would abort the process if the planner defined getPlannerData
+    assert data.numVertices() == 0
+    data = planner.plannerData()
+    stats = planner.stats
+    assert data.numVertices() == stats.start_tree_size + stats.goal_tree_size
+    tags = [data.getVertex(i).getTag() for i in range(data.numVertices())]
+    assert tags.count(1) == stats.start_tree_size and tags.count(2) == stats.goal_tree_size
+    assert data.numStartVertices() == 1 and data.numGoalVertices() == 1
+    assert data.numEdges() == data.numVertices() - 2  # every vertex but the two roots has a parent edge
+    # edges run parent -> child: a start root only has outgoing edges
+    start_root = data.getStartIndex(0)
+    assert data.getIncomingEdges(start_root) == [] and data.getEdges(start_root)
+
+
+# -- statuses -------------------------------------------------------------------------
+
+
+def status_of(ss, planner, time_limit=1.0):
+    ss.setPlanner(planner)
+    return ss.solve(time_limit).getStatus()
+
+
+def test_start_in_collision_is_invalid_start():
+    problem = get_problem("narrow_gap")
+    ss = problem.setup()
+    space = ss.getStateSpace()
+    start = space.allocState()
+    start[0], start[1] = 0.5, 0.2  # inside the wall
+    ss.setStartState(start)
+    assert status_of(ss, BalancedRRTConnect(ss.getSpaceInformation())) == ob.PlannerStatus.INVALID_START
+
+
+def test_goal_in_collision_is_invalid_goal():
+    ss = get_problem("narrow_gap").setup()
+    goal = ss.getStateSpace().allocState()
+    goal[0], goal[1] = 0.5, 0.8
+    ss.setGoalState(goal)
+    assert status_of(ss, BalancedRRTConnect(ss.getSpaceInformation())) == ob.PlannerStatus.INVALID_GOAL
+
+
+def test_impossible_problem_times_out_on_time():
+    walled = get_problem("narrow_gap").boxes[0][:3] + (1.0,)  # close the gap
+    world = BoxWorld2D((walled,))
+    ss = get_problem("narrow_gap").setup()
+    ss.setStateValidityChecker(world)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    ss.setup()
+    began = time.perf_counter()
+    status = ss.solve(0.2)
+    elapsed = time.perf_counter() - began
+    assert status == ob.PlannerStatus.TIMEOUT
+    assert not ss.haveSolutionPath()
+    # one iteration of this planner takes well under 50 ms
+    assert elapsed < 0.2 + 0.05
+    assert planner.stats.iterations > 10
+
+
+def test_multiple_start_states_and_goal_states():
+    problem = get_problem("narrow_gap")
+    ss = problem.setup()
+    si = ss.getSpaceInformation()
+    space = ss.getStateSpace()
+    starts = []
+    for x, y in ((0.1, 0.2), (0.1, 0.8)):
+        start = space.allocState()
+        start[0], start[1] = x, y
+        starts.append(start)
+    ss.clearStartStates()
+    for start in starts:
+        ss.addStartState(start)
+    goals = ob.GoalStates(si)
+    for x, y in ((0.9, 0.1), (0.9, 0.9), (0.8, 0.5)):
+        goal = space.allocState()
+        goal[0], goal[1] = x, y
+        goals.addState(goal)
+    ss.setGoal(goals)
+    planner = BalancedRRTConnect(si)
+    ss.setPlanner(planner)
+    assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert_valid_solution(ss, problem.world(), starts, goals.isSatisfied)
+    assert planner.plannerData().numStartVertices() == 2
+
+
+def test_clear_then_solve_again():
+    problem, ss, planner, status = solve_problem("maze")
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    first_sizes = planner.stats.start_tree_size + planner.stats.goal_tree_size
+    ss.clear()
+    assert planner.plannerData().numVertices() == 0
+    assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.stats.start_tree_size + planner.stats.goal_tree_size > 0
+    assert_valid_solution(ss, problem.world(), start_states(problem, ss), goal_test_for(ss))
+    assert first_sizes > 0
+
+
+def test_stats_count_the_work_of_one_solve():
+    problem, ss, planner, status = solve_problem("narrow_gap")
+    stats = planner.stats
+    assert stats.status == "Exact solution"
+    assert stats.iterations >= 1 and stats.time > 0
+    assert stats.motions_checked >= stats.iterations - 1  # at least one motion per successful sample
+    assert stats.states_checked >= stats.motions_checked
+    assert stats.states_checked == read_work(ss.getSpaceInformation()).states_checked  # first solve: all of it
+    assert 0 <= stats.tree_swaps < stats.iterations
+
+
+# -- parameters --------------------------------------------------------------------------
+
+
+ROUND_TRIPS = {
+    "range": ("0.125", "0.125"),
+    "intermediate_states": ("true", "1"),
+    "balance_tree_sizes": ("0", "0"),
+    "max_tree_size_ratio": ("2.5", "2.5"),
+    "seed": ("42", "42"),
+}
+
+
+def test_every_parameter_round_trips():
+    planner = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation())
+    params = planner.params()
+    assert sorted(params.getParamNames()) == sorted(ROUND_TRIPS)
+    for name, (value, expected) in ROUND_TRIPS.items():
+        assert params.setParam(name, value), name
+        assert params.getParam(name) == expected, name
+    assert planner.getRange() == 0.125 and planner.getIntermediateStates() is True
+    assert planner.getBalanceTreeSizes() is False and planner.getMaxTreeSizeRatio() == 2.5
+    assert params.getRangeSuggestion("max_tree_size_ratio") == "0.:0.05:10."
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [("no_such_param", "1"), ("max_tree_size_ratio", "abc"), ("max_tree_size_ratio", "-0.5"),
+     ("range", "-1"), ("balance_tree_sizes", "maybe"), ("seed", "-3"), ("seed", "1.5")],
+)
+def test_bad_parameters_are_refused_and_change_nothing(name, value):
+    planner = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation())
+    before = planner.params().getParams()
+    assert planner.params().setParam(name, value) is False
+    assert planner.params().getParams() == before
+
+
+# -- randomness ---------------------------------------------------------------------------
+
+SEEDED_RUN = """
+import sys
+from ompl import util as ou
+ou.RNG.setSeed(int(sys.argv[1]))
+ou.setLogLevel(ou.LOG_NONE)
+from ompl_balance import BalancedRRTConnect
+from ompl_balance.problems import get_problem
+ss = get_problem("maze").setup()
+ss.setPlanner(BalancedRRTConnect(ss.getSpaceInformation()))
+ss.solve(10.0)
+path = ss.getSolutionPath()
+print([round(path.getState(i)[j], 12) for i in range(path.getStateCount()) for j in range(2)])
+"""
+
+
+def seeded_path(seed: int) -> str:
+    result = subprocess.run(
+        [sys.executable, "-c", SEEDED_RUN, str(seed)], capture_output=True, text=True, timeout=120, cwd=REPO, check=True
+    )
+    return result.stdout.strip()
+
+
+def test_same_seed_same_path_in_a_fresh_process():
+    first, second, other = seeded_path(7), seeded_path(7), seeded_path(8)
+    assert first and first == second
+    assert other != first
+
+
+def test_two_solves_in_one_process_differ():
+    paths = []
+    for _ in range(2):
+        problem, ss, planner, status = solve_problem("maze")
+        path = ss.getSolutionPath()
+        paths.append([path.getState(i)[j] for i in range(path.getStateCount()) for j in range(2)])
+    assert paths[0] != paths[1]
+
+
+def test_fixed_seed_parameter_repeats_the_path_in_one_process():
+    paths = []
+    for _ in range(2):
+        problem, ss, planner, status = solve_problem("maze", lambda p: p.setSeed(123))
+        path = ss.getSolutionPath()
+        paths.append([path.getState(i)[j] for i in range(path.getStateCount()) for j in range(2)])
+    assert paths[0] == paths[1]

@@ -1,0 +1,197 @@
+"""Collision answers against an independent FCL query, and the OMPL adapters against OMPL's own."""
+
+from pathlib import Path
+
+import fcl
+import numpy as np
+import pytest
+import yourdfpy
+from ompl import base as ob
+from ompl import geometric as og
+
+from ompl_balance.counting import read_work
+from ompl_balance.kinematics import RobotModel
+from ompl_balance.validity import (CollisionChecker, Environment, MotionValidator, StateValidityChecker,
+                                   coarse_to_fine, setup_robot, space_for)
+
+ROBOTS = Path(__file__).resolve().parent / "robots"
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"shared data not found at {DATA}")
+
+
+def arm3_scene():
+    robot = RobotModel.from_urdf(ROBOTS / "arm3.urdf", ROBOTS / "arm3.srdf", package_map={"testbot": str(ROBOTS)})
+    environment = Environment()
+    environment.add_box("wall", [0.05, 0.4, 0.3], [0.55, 0.0, 0.3], [0.0, 0.0, 0.3826834, 0.9238795])
+    environment.add_sphere("ball", 0.1, [-0.3, 0.35, 0.5])
+    environment.add_cylinder("post", 0.05, 0.8, [-0.1, -0.5, 0.4], [0.3826834, 0.0, 0.0, 0.9238795])
+    environment.add_mesh("cone", ROBOTS / "meshes" / "cone.obj", [0.0, 0.45, 0.2])
+    return robot, environment, ROBOTS / "arm3.urdf"
+
+
+def panda_scene():
+    from ompl_balance.mbm import load_mbm
+    from ompl_balance.robots import load_panda_vamp
+
+    robot = load_panda_vamp(DATA / "robots" / "panda_vamp")
+    problem = load_mbm(DATA / "mbm" / "panda" / "table_pick.json", robot.joint_names)[0]
+    return robot, problem.environment, DATA / "robots" / "panda_vamp" / "panda.urdf"
+
+
+def independent_answers(robot, environment, urdf_path, q):
+    """(env collision, self collision) per configuration: yourdfpy FK, fresh FCL objects, every pair."""
+    urdf = yourdfpy.URDF.load(str(urdf_path), load_meshes=False, build_collision_scene_graph=False)
+    collisions = [(link.name, c) for link in urdf.robot.links for c in link.collisions]
+    assert [name for name, _ in collisions] == [g.link for g in robot.geometries]
+    request = fcl.CollisionRequest()
+    obstacles = [fcl.CollisionObject(o.shape.fcl_geometry(), fcl.Transform(o.pose[:3, :3], o.pose[:3, 3]))
+                 for o in environment.obstacles]
+    root = robot.link_names[0]
+    env_hits, self_hits = [], []
+    for x in q:
+        urdf.update_cfg(dict(zip(robot.joint_names, x)))
+        objects = []
+        for (link, collision), geometry in zip(collisions, robot.geometries):
+            origin = np.eye(4) if collision.origin is None else collision.origin
+            pose = urdf.get_transform(link, root) @ origin
+            objects.append(fcl.CollisionObject(geometry.shape.fcl_geometry(), fcl.Transform(pose[:3, :3], pose[:3, 3])))
+        env_hits.append(any(fcl.collide(a, b, request, fcl.CollisionResult()) for a in objects for b in obstacles))
+        self_hits.append(any(fcl.collide(objects[i], objects[j], request, fcl.CollisionResult())
+                             for i, j in robot.self_collision_pairs))
+    return np.array(env_hits), np.array(self_hits)
+
+
+def check_scene(scene, count, seed):
+    robot, environment, urdf_path = scene
+    q = np.random.default_rng(seed).uniform(robot.lower, robot.upper, size=(count, robot.dof))
+    env_hits, self_hits = independent_answers(robot, environment, urdf_path, q)
+    # the sample must exercise every kind of answer
+    assert env_hits.sum() >= 5 and self_hits.sum() >= 5 and (~env_hits & ~self_hits).sum() >= 5
+    expected = ~(env_hits | self_hits)
+    np.testing.assert_array_equal(CollisionChecker(robot, environment).check(q), expected)
+    np.testing.assert_array_equal(CollisionChecker(robot, environment, spheres_per_geometry=1).check(q), expected)
+    np.testing.assert_array_equal(CollisionChecker(robot, environment, prefilter=False).check(q), expected)
+    self_only = CollisionChecker(robot)
+    np.testing.assert_array_equal(self_only.check(q), ~self_hits)
+
+
+def test_collisions_agree_with_independent_fcl_arm3():
+    check_scene(arm3_scene(), 300, seed=1)
+
+
+@needs_data
+def test_collisions_agree_with_independent_fcl_panda_table_pick():
+    check_scene(panda_scene(), 250, seed=2)
+
+
+def make_si(robot, checker, resolution=0.01):
+    space = space_for(robot)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityCheckingResolution(resolution)
+    return space, si
+
+
+def random_edges(robot, checker, count, rng):
+    edges = []
+    while len(edges) < count:
+        a = rng.uniform(robot.lower, robot.upper)
+        if checker.is_valid(a):
+            edges.append((a, rng.uniform(robot.lower, robot.upper)))
+    return edges
+
+
+def check_motion_validator(robot, environment, edges_count, seed):
+    rng = np.random.default_rng(seed)
+    checker = CollisionChecker(robot, environment)
+    space, si = make_si(robot, checker)
+    validity, motion = setup_robot(si, checker)
+    si.setup()
+    discrete_space, discrete_si = make_si(robot, checker)
+    discrete_si.setStateValidityChecker(StateValidityChecker(discrete_si, CollisionChecker(robot, environment)))
+    discrete_si.setup()
+    s1, s2, last = si.allocState(), si.allocState(), si.allocState()
+    outcomes = []
+    for a, b in random_edges(robot, checker, edges_count, rng):
+        space.copyFromReals(s1, list(a))
+        space.copyFromReals(s2, list(b))
+        nd = space.validSegmentCount(s1, s2)
+        before = read_work(si)
+        valid = si.checkMotion(s1, s2)
+        work = read_work(si) - before
+        assert work.motions_checked == 1
+        assert work.states_checked == nd if valid else 1 <= work.states_checked <= nd
+        assert valid == discrete_si.checkMotion(s1, s2)
+        # last valid state: the first invalid state walking from s1, as OMPL's overload
+        walk = checker.check(a + (np.arange(1, nd + 1) / nd)[:, None] * (b - a))
+        valid_again, fraction = motion.check_motion_last_valid(s1, s2, last)
+        assert valid_again == valid == walk.all()
+        if not valid:
+            first = int(np.argmin(walk))
+            assert fraction == pytest.approx(first / nd)
+            np.testing.assert_allclose(last[0:robot.dof], a + first / nd * (b - a), atol=1e-12)
+        outcomes.append(valid)
+    assert 3 <= sum(outcomes) <= len(outcomes) - 3, "edges should be both free and colliding"
+
+
+def test_motion_validator_matches_discrete_arm3():
+    robot, environment, _ = arm3_scene()
+    check_motion_validator(robot, environment, 60, seed=3)
+
+
+@needs_data
+def test_motion_validator_matches_discrete_panda():
+    robot, environment, _ = panda_scene()
+    check_motion_validator(robot, environment, 40, seed=4)
+
+
+def test_coarse_to_fine_visits_every_state_once():
+    for nd in range(1, 40):
+        order = coarse_to_fine(nd)
+        assert sorted(order) == list(range(nd)) and order[0] == nd - 1
+    assert coarse_to_fine(8)[:4] == [7, 3, 1, 5]
+
+
+def test_space_bounds_and_planning_with_rrtconnect():
+    robot, environment, _ = arm3_scene()
+    space = space_for(robot)
+    bounds = space.getBounds()
+    assert [bounds.low[i] for i in range(3)] == pytest.approx(list(robot.lower))
+    assert [bounds.high[i] for i in range(3)] == pytest.approx(list(robot.upper))
+    checker = CollisionChecker(robot, environment)
+    ss = og.SimpleSetup(space)
+    validity, motion = setup_robot(ss, checker)
+    si = ss.getSpaceInformation()
+    assert si.getStateValidityChecker() is validity and si.getMotionValidator() is motion
+    start, goal = si.allocState(), si.allocState()
+    for i, (a, b) in enumerate(zip([0.0, -1.0, 0.1], [2.5, 1.0, 0.1])):  # copyFromReals needs space.setup()
+        start[i], goal[i] = a, b
+    ss.setStartAndGoalStates(start, goal)
+    ss.setPlanner(og.RRTConnect(si))
+    assert ss.solve(5.0)
+    path = ss.getSolutionPath()
+    states = np.array([path.getState(i)[0:3] for i in range(path.getStateCount())])
+    assert checker.check(states).all()
+    work = read_work(si)
+    assert work.motions_checked > 0 and work.states_checked > work.motions_checked
+
+
+def test_bad_input():
+    robot, environment, _ = arm3_scene()
+    checker = CollisionChecker(robot, environment)
+    with pytest.raises(ValueError, match="'slide'"):
+        checker.check([0.0, 0.0, np.inf])
+    space, si = make_si(robot, checker)
+    validity = StateValidityChecker(si, checker)
+    state = si.allocState()
+    state[0], state[1], state[2] = 0.0, float("nan"), 0.0
+    with pytest.raises(ValueError, match="'shoulder'"):
+        validity.isValid(state)
+    with pytest.raises(ValueError, match="dimension 2"):
+        setup_robot(ob.SpaceInformation(ob.RealVectorStateSpace(2)), checker)
+    with pytest.raises(ValueError, match="'wall'"):
+        environment.add_box("wall", [1, 1, 1])
+    with pytest.raises(ValueError, match="'tilted'.*quaternion"):
+        environment.add_box("tilted", [1, 1, 1], orientation_xyzw=[0, 0, 1, 1])
+    with pytest.raises(ValueError, match="positive"):
+        environment.add_sphere("flat", 0.0)
+    assert isinstance(MotionValidator(si, checker), ob.MotionValidator)
