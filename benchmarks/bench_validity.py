@@ -11,7 +11,8 @@ Compares, in one run on the same states and edges (and checks the answers agree)
   collision-free edges of planner-like length.
 
 Usage: ``python benchmarks/bench_validity.py [--data DIR] [--scenes 3] [--states 600] [--edges 300]``
-(DIR defaults to ``<repo>/../shared/data``). Figures are medians over scenes of per-scene ratios.
+(DIR defaults to ``<repo>/../shared/data``). Times are CPU time of the process with the checkers
+interleaved; figures are medians over scenes of per-scene ratios.
 """
 
 from __future__ import annotations
@@ -27,6 +28,29 @@ from ompl import base as ob
 from ompl_balance.mbm import load_mbm
 from ompl_balance.robots import load_panda_vamp
 from ompl_balance.validity import CollisionChecker, StateValidityChecker, setup_robot, space_for
+
+
+def straightforward_body_poses(robot, q):
+    """Body poses (n, bodies, 4, 4) by plain batched numpy FK: the package's first FK, kept
+    here unchanged so that the baseline does not speed up with the package."""
+    joints = robot._joints  # noqa: SLF001 (the model's own joint list)
+    source = np.array([j.source for j in joints])
+    values = q[:, source] * np.array([j.multiplier for j in joints]) + np.array([j.shift for j in joints])
+    axis = np.array([j.axis for j in joints])
+    x, y, z = axis.T
+    zero = np.zeros_like(x)
+    cross = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1).reshape(-1, 3, 3)
+    revolute = np.array([j.kind == "revolute" for j in joints], dtype=float)[:, None, None]
+    motion = np.broadcast_to(np.eye(4), values.shape + (4, 4)).copy()
+    s, c = np.sin(values)[..., None, None], np.cos(values)[..., None, None]
+    motion[..., :3, :3] += revolute * (s * cross + (1.0 - c) * (cross @ cross))
+    motion[..., :3, 3] += (1.0 - revolute[:, :, 0]) * values[..., None] * axis
+    local = np.array([j.offset for j in joints]) @ motion
+    poses = np.empty((len(q), len(joints) + 1, 4, 4))
+    poses[:, 0] = np.eye(4)
+    for k, joint in enumerate(joints, start=1):
+        poses[:, k] = poses[:, joint.parent_body] @ local[:, k - 1]
+    return poses
 
 
 class BaselineChecker:
@@ -47,7 +71,7 @@ class BaselineChecker:
         self.request = fcl.CollisionRequest()
 
     def is_valid(self, q) -> bool:
-        bodies = self.robot.body_poses(q)[0]  # (bodies, 4, 4)
+        bodies = straightforward_body_poses(self.robot, np.asarray(q, dtype=float)[None])[0]  # (bodies, 4, 4)
         for obj, geometry in zip(self.links, self.robot.geometries):
             pose = bodies[geometry.body] @ geometry.origin
             obj.setTransform(fcl.Transform(pose[:3, :3], pose[:3, 3]))
@@ -61,10 +85,11 @@ class BaselineChecker:
 
 
 def timed(function, *args):
-    """``(result, seconds)`` of one call."""
-    start = time.perf_counter()
+    """``(result, seconds)`` of one call, in CPU time of this process (steadier than wall time
+    on a shared machine)."""
+    start = time.process_time()
     result = function(*args)
-    return result, time.perf_counter() - start
+    return result, time.process_time() - start
 
 
 def random_edges(robot, checker, count, length, rng):
@@ -95,31 +120,38 @@ def bench_scene(robot, problem, states, edge_count, rng):
     si_discrete.setStateValidityChecker(StateValidityChecker(si_discrete, checker))
     si_discrete.setup()
 
-    expected, t_base = timed(lambda: np.array([baseline.is_valid(x) for x in q]))
+    # the three ways interleaved, chunk by chunk, so that the machine's load hits them alike
     state = si_package.allocState()
-    def one_by_one():
-        answers = []
-        for x in q:
+    expected, single, batched = [], [], []
+    t_base = t_single = t_batch = 0.0
+    for chunk in np.array_split(q, max(1, states // 20)):
+        answers, elapsed = timed(lambda: [baseline.is_valid(x) for x in chunk])
+        expected += answers
+        t_base += elapsed
+        for x in chunk:
             space.copyFromReals(state, list(x))
-            answers.append(validity.isValid(state))
-        return np.array(answers)
-    single, t_single = timed(one_by_one)
-    batched, t_batch = timed(lambda: np.concatenate([checker.check(q[i:i + 20]) for i in range(0, states, 20)]))
-    assert (single == expected).all() and (batched == expected).all(), "package checker disagrees with the baseline"
+            answer, elapsed = timed(validity.isValid, state)
+            single.append(answer)
+            t_single += elapsed
+        answers, elapsed = timed(checker.check, chunk)
+        batched += list(answers)
+        t_batch += elapsed
+    expected = np.array(expected)
+    assert (np.array(single) == expected).all() and (np.array(batched) == expected).all(), \
+        "package checker disagrees with the baseline"
 
     length = 0.2 * space.getMaximumExtent()  # RRT-Connect's default range
     edges = random_edges(robot, checker, edge_count, length, rng)
     s1, s2 = si_package.allocState(), si_package.allocState()
-    results = {}
-    for name, si in (("discrete", si_discrete), ("package", si_package)):
-        answers, elapsed = [], []
-        for a, b in edges:
-            space.copyFromReals(s1, list(a))
-            space.copyFromReals(s2, list(b))
-            start = time.perf_counter()
-            answers.append(si.checkMotion(s1, s2))
-            elapsed.append(time.perf_counter() - start)
-        results[name] = (np.array(answers), np.array(elapsed))
+    results = {"discrete": ([], []), "package": ([], [])}
+    for a, b in edges:  # the two validators alternate edge by edge
+        space.copyFromReals(s1, list(a))
+        space.copyFromReals(s2, list(b))
+        for name, si in (("discrete", si_discrete), ("package", si_package)):
+            answer, elapsed = timed(si.checkMotion, s1, s2)
+            results[name][0].append(answer)
+            results[name][1].append(elapsed)
+    results = {name: (np.array(answers), np.array(elapsed)) for name, (answers, elapsed) in results.items()}
     free = results["discrete"][0]
     assert (results["package"][0] == free).all(), "batched motion validator disagrees with OMPL's discrete validator"
     t_discrete, t_package = results["discrete"][1], results["package"][1]

@@ -1,45 +1,33 @@
-"""Side-by-side comparison of planners on the same problems, in one process.
+"""Benchmarks: run an experiment into an output folder; ``compare`` is a ready-made experiment.
 
-Each run builds a fresh ``SimpleSetup`` for its problem (with a counting validity
-checker), so stock OMPL planners and this package's planners use the same checker and
-motion validator. Runs of the different planners are interleaved (run 1 of every
-planner, then run 2, ...) so that slow phases of a shared machine hit them alike.
+:func:`bench` executes an :class:`~ompl_balance.experiment.Experiment` (each run in its
+own process, see :mod:`ompl_balance.runner`) and keeps everything in one folder::
+
+    OUT/experiment.json     the experiment (a later run of the same experiment resumes)
+    OUT/results.jsonl       one record per finished run, appended as runs finish
+    OUT/logs/*.log          one OMPL benchmark log per problem (ompl_log.write_logs)
+    OUT/benchmark.db        the logs converted by OMPL's own converter
+    OUT/summary.md, .csv    medians, 95 % intervals, ratios to the baseline planner
+
+The logs, database and summary are rewritten from ``results.jsonl`` at the end of every
+sweep, interrupted or not.
 """
 
 from __future__ import annotations
 
-import statistics
-import time
-from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+import json
+import random
+import re
+from collections.abc import Sequence
+from pathlib import Path
 
-from ompl import base as ob
-from ompl import geometric as og
 from tqdm import tqdm
 
-from .counting import read_work
-from .planners import BalancedRRTConnect
-from .problems import Problem
-
-PlannerFactory = Callable[[ob.SpaceInformation], ob.Planner]
-
-
-@dataclass(frozen=True)
-class PlannerSpec:
-    """A planner to compare: a display label and a factory ``si -> planner``."""
-
-    label: str
-    factory: PlannerFactory
-
-
-def _balanced(balance: bool) -> PlannerFactory:
-    def make(si: ob.SpaceInformation) -> BalancedRRTConnect:
-        planner = BalancedRRTConnect(si)
-        planner.setBalanceTreeSizes(balance)
-        return planner
-
-    return make
-
+from .experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec
+from .ompl_log import to_database, write_logs
+from .problems import PROBLEMS
+from .runner import Progress, Record, ResultStore, sweep
+from .summary import format_csv, format_markdown, summarize
 
 STOCK_LABEL = "RRTConnect"
 
@@ -47,144 +35,99 @@ STOCK_LABEL = "RRTConnect"
 def default_planners() -> list[PlannerSpec]:
     """Stock ``og.RRTConnect`` (the baseline) and ``BalancedRRTConnect`` with balancing on and off."""
     return [
-        PlannerSpec(STOCK_LABEL, og.RRTConnect),
-        PlannerSpec("BalancedRRTConnect", _balanced(True)),
-        PlannerSpec("BalancedRRTConnect[balance=0]", _balanced(False)),
+        PlannerSpec(STOCK_LABEL, STOCK_LABEL),
+        PlannerSpec("BalancedRRTConnect", "BalancedRRTConnect"),
+        PlannerSpec("BalancedRRTConnect[balance_tree_sizes=0]", "BalancedRRTConnect", params={"balance_tree_sizes": "0"}),
     ]
 
 
-@dataclass(frozen=True)
-class RunResult:
-    """One planner run: whether it solved and the work it took."""
+def parse_planners(text: str) -> list[PlannerSpec]:
+    """Planners from ``"RRTConnect,BalancedRRTConnect[max_tree_size_ratio=0.5;range=0.1]"``.
 
-    problem: str
-    planner: str
-    solved: bool
-    time: float  # wall-clock seconds in ss.solve
-    states_checked: int
-    motions_checked: int
-    nodes: int  # states in the planner's graph (both trees for RRT-Connect)
-
-
-def graph_size(ss: og.SimpleSetup, planner: ob.Planner) -> int:
-    """Vertices in the planner's graph: ``plannerData()`` for ours, ``getPlannerData`` for stock."""
-    if hasattr(planner, "plannerData"):
-        return planner.plannerData().numVertices()
-    data = ob.PlannerData(ss.getSpaceInformation())
-    ss.getPlannerData(data)
-    return data.numVertices()
-
-
-def run_once(problem: Problem, spec: PlannerSpec, time_limit: float) -> RunResult:
-    """Solve ``problem`` once with a fresh planner from ``spec``."""
-    ss = problem.setup()
-    si = ss.getSpaceInformation()
-    planner = spec.factory(si)
-    ss.setPlanner(planner)
-    ss.setup()
-    before = read_work(si)
-    began = time.perf_counter()
-    ss.solve(time_limit)
-    elapsed = time.perf_counter() - began
-    work = read_work(si) - before
-    return RunResult(
-        problem=problem.name,
-        planner=spec.label,
-        solved=bool(ss.haveExactSolutionPath()),
-        time=elapsed,
-        states_checked=work.states_checked,
-        motions_checked=work.motions_checked,
-        nodes=graph_size(ss, planner),
-    )
-
-
-def compare(
-    problems: Sequence[Problem],
-    planners: Sequence[PlannerSpec],
-    runs: int,
-    time_limit: float,
-    progress: bool = True,
-) -> list[RunResult]:
-    """Run every planner ``runs`` times on every problem, interleaving planners."""
-    if runs < 1:
-        raise ValueError(f"runs must be >= 1, got {runs}")
-    if not time_limit > 0:
-        raise ValueError(f"time limit must be a positive number of seconds, got {time_limit}")
-    jobs = [(problem, spec) for problem in problems for _ in range(runs) for spec in planners]
-    return [run_once(problem, spec, time_limit) for problem, spec in tqdm(jobs, disable=not progress, unit="run")]
-
-
-@dataclass(frozen=True)
-class Summary:
-    """Medians over one (problem, planner) cell, and ratios to the baseline's medians."""
-
-    problem: str
-    planner: str
-    runs: int
-    success: float
-    time: float
-    states_checked: float
-    nodes: float
-    time_ratio: float
-    checks_ratio: float
-    nodes_ratio: float
-
-
-def _ratio(value: float, baseline: float) -> float:
-    return value / baseline if baseline > 0 else float("nan")
-
-
-def summarize(results: Iterable[RunResult], baseline: str = STOCK_LABEL) -> list[Summary]:
-    """One :class:`Summary` per (problem, planner), in first-seen order.
-
-    Medians are over all runs of a cell, solved or not (an unsolved run counts with
-    the time and work it spent until the limit).
+    Each item is a planner or preset name, optionally with ``[name=value;...]``
+    parameter overrides; the item as written is its label.
     """
-    cells: dict[tuple[str, str], list[RunResult]] = {}
-    for result in results:
-        cells.setdefault((result.problem, result.planner), []).append(result)
-    medians = {
-        key: (
-            statistics.median(r.time for r in runs),
-            statistics.median(r.states_checked for r in runs),
-            statistics.median(r.nodes for r in runs),
-        )
-        for key, runs in cells.items()
-    }
-    summaries = []
-    for (problem, planner), runs in cells.items():
-        time_median, checks_median, nodes_median = medians[problem, planner]
-        base = medians.get((problem, baseline), (float("nan"),) * 3)
-        summaries.append(
-            Summary(
-                problem=problem,
-                planner=planner,
-                runs=len(runs),
-                success=sum(r.solved for r in runs) / len(runs),
-                time=time_median,
-                states_checked=checks_median,
-                nodes=nodes_median,
-                time_ratio=_ratio(time_median, base[0]),
-                checks_ratio=_ratio(checks_median, base[1]),
-                nodes_ratio=_ratio(nodes_median, base[2]),
-            )
-        )
-    return summaries
+    specs = []
+    for item in (part.strip() for part in re.split(r",(?![^\[]*\])", text)):
+        match = re.fullmatch(r"([A-Za-z_][\w.]*)(?:\[(.*)\])?", item)
+        if not match:
+            raise ValueError(f"cannot read planner {item!r}; write NAME or NAME[param=value;...]")
+        params = dict(pair.split("=", 1) for pair in filter(None, (match.group(2) or "").split(";")) if "=" in pair)
+        specs.append(PlannerSpec(item, match.group(1), params=params))
+    return specs
 
 
-def format_table(summaries: Sequence[Summary]) -> str:
-    """A markdown table per problem: success, medians, and ratios to the baseline."""
-    header = (
-        "| planner | runs | success | median time (ms) | median validity checks | median nodes "
-        "| time ratio | checks ratio | nodes ratio |\n|---|---|---|---|---|---|---|---|---|"
+def compare_experiment(problems: Sequence[str] = tuple(PROBLEMS), planners: Sequence[PlannerSpec] | None = None,
+                       runs: int = 20, time_limit: float = 5.0, seed: int | None = None) -> Experiment:
+    """The ``ompl-balance compare`` experiment: built-in problems, stock RRTConnect as the baseline.
+
+    ``seed=None`` draws one (it is recorded in ``experiment.json`` and the logs).
+    """
+    planners = list(planners or default_planners())
+    return Experiment(
+        name="compare",
+        problems=tuple(ProblemSpec(name, "builtin", name) for name in problems),
+        planners=tuple(planners),
+        runs=runs,
+        time_limit=time_limit,
+        seed=random.randrange(1, 2**31 - 1) if seed is None else seed,
+        baseline=STOCK_LABEL if any(p.label == STOCK_LABEL for p in planners) else "",
     )
-    blocks = []
-    for problem in dict.fromkeys(s.problem for s in summaries):
-        rows = [
-            f"| {s.planner} | {s.runs} | {s.success:.0%} | {s.time * 1e3:.1f} | {s.states_checked:.0f} | {s.nodes:.0f} "
-            f"| {s.time_ratio:.2f} | {s.checks_ratio:.2f} | {s.nodes_ratio:.2f} |"
-            for s in summaries
-            if s.problem == problem
-        ]
-        blocks.append(f"### {problem}\n\n{header}\n" + "\n".join(rows))
-    return "\n\n".join(blocks)
+
+
+def _claim(out: Path, experiment: Experiment) -> None:
+    """Record ``experiment`` in ``out``; refuse a folder holding results of a different experiment."""
+    path = out / "experiment.json"
+    if path.exists() and (out / "results.jsonl").exists():
+        previous = Experiment.from_dict(json.loads(path.read_text()))
+        mine, theirs = experiment.results_identity(), previous.results_identity()
+        differing = sorted(key for key in mine if mine[key] != theirs.get(key))
+        if differing:
+            raise ExperimentError(str(out), f"holds results of an experiment with other {', '.join(differing)}; "
+                                            "use another output folder")
+    out.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(experiment.as_dict(), indent=1))
+
+
+def write_outputs(experiment: Experiment, records: Sequence[Record], out: Path) -> str:
+    """Logs, database and summary from ``records``; returns the markdown summary."""
+    logs = write_logs(experiment, records, out / "logs")
+    if logs:
+        to_database(logs, out / "benchmark.db")
+    summaries = summarize(records, experiment.baseline_label, [p.label for p in experiment.planners])
+    table = format_markdown(summaries, experiment.baseline_label)
+    (out / "summary.md").write_text(table + "\n")
+    (out / "summary.csv").write_text(format_csv(summaries))
+    return table
+
+
+def experiment_records(experiment: Experiment, store: ResultStore) -> list[Record]:
+    """The records in ``store`` that belong to ``experiment`` (its problems, planners and run indices)."""
+    keys = {task.key for task in experiment.tasks()}
+    return [r for r in store.records() if (r["problem"], r["planner"], r["run"]) in keys]
+
+
+def bench(experiment: Experiment, out: str | Path, jobs: int = 1, dask: str | None = None, progress: bool = True) -> list[Record]:
+    """Run what is missing of ``experiment`` into ``out`` and write the logs, database and summary.
+
+    ``jobs`` runs at a time on this machine, or on the Dask cluster ``dask``. Returns
+    the experiment's records (all of them, earlier sweeps' included).
+    """
+    out = Path(out)
+    _claim(out, experiment)
+    store = ResultStore(out / "results.jsonl")
+    total = len(experiment.tasks())
+    bar = tqdm(total=total, initial=len(experiment_records(experiment, store)), disable=not progress, unit="run",
+               smoothing=0.1, dynamic_ncols=True)
+
+    def show(record: Record, counts: Progress) -> None:
+        bar.update(1)
+        bar.set_postfix(unsolved=counts.unsolved, crashed=counts.crashed, refresh=False)
+
+    try:
+        sweep(experiment, store, jobs=jobs, dask=dask, on_record=show)
+    finally:
+        bar.close()
+        records = experiment_records(experiment, store)
+        write_outputs(experiment, records, out)
+    return records

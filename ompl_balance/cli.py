@@ -1,21 +1,35 @@
 """The ``ompl-balance`` command line.
 
-``ompl-balance compare`` runs stock ``og.RRTConnect`` and ``BalancedRRTConnect`` (with
-balancing on and off) on the built-in 2-D problems and prints, per problem, success
-rate, median time, median validity checks, median nodes and each planner's ratios to
-stock RRT-Connect.
+``ompl-balance compare``
+    stock ``og.RRTConnect`` against ``BalancedRRTConnect`` (balancing on and off), or
+    the planners given with ``--planners``, on the built-in 2-D problems; prints per
+    problem the success rate, median time and median validity checks, each with its
+    95 % interval and its ratio to stock RRT-Connect.
+``ompl-balance bench EXPERIMENT.toml -o OUT/``
+    runs an experiment file (docs/benchmark.md) into ``OUT/``: results, OMPL logs, the
+    SQLite database and the summary; running it again resumes.
+``ompl-balance plot OUT/``
+    box plots, success-vs-time curves, the summary table and, for 2-D problems, the
+    two trees of balanced and alternating growth (needs matplotlib: the ``plot`` extra).
+
+Every run executes in its own process; ``--jobs N`` runs N at a time, ``--dask
+tcp://HOST:PORT`` or ``--dask local:N`` on a Dask cluster (the ``distributed`` extra).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
+import tempfile
 from collections.abc import Sequence
+from pathlib import Path
 
 from ompl import util as ou
 
-from .benchmark import compare, default_planners, format_table, summarize
-from .problems import PROBLEMS, get_problem
+from .benchmark import bench, compare_experiment, parse_planners
+from .experiment import Experiment, ExperimentError, load_experiment
+from .problems import PROBLEMS
 
 
 def _problem_names(text: str) -> list[str]:
@@ -26,6 +40,13 @@ def _problem_names(text: str) -> list[str]:
             f"unknown problem(s) {', '.join(unknown) or '(none given)'}; choose from {', '.join(PROBLEMS)}"
         )
     return names
+
+
+def _planners(text: str):
+    try:
+        return parse_planners(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from error
 
 
 def _positive_int(text: str) -> int:
@@ -42,47 +63,93 @@ def _positive_float(text: str) -> float:
     return value
 
 
-def _seed(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text}")
-    return value
+def _dask_address(text: str) -> str:
+    if text.startswith("tcp://") or (text.startswith("local:") and text[6:].isdigit() and int(text[6:]) >= 1):
+        return text
+    raise argparse.ArgumentTypeError(f"expected tcp://HOST:PORT or local:N (N >= 1 workers), got {text!r}")
+
+
+def _add_execution_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--jobs", type=_positive_int, default=1,
+                        help="runs at a time on this machine (default 1; more than the free cores distorts times)")
+    parser.add_argument("--dask", type=_dask_address, default=None, metavar="ADDRESS",
+                        help="run on a Dask cluster: tcp://HOST:PORT, or local:N for N local workers")
+    parser.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="ompl-balance", description=__doc__.split("\n\n")[0])
     commands = parser.add_subparsers(dest="command", required=True)
-    compare_parser = commands.add_parser(
-        "compare",
-        help="compare BalancedRRTConnect with stock RRTConnect on the built-in problems",
-        description=__doc__.split("\n\n", 1)[1],
-    )
-    compare_parser.add_argument("--runs", type=_positive_int, default=20, help="runs per planner and problem (default 20)")
-    compare_parser.add_argument(
-        "--time-limit", type=_positive_float, default=5.0, help="seconds each run may plan (default 5)"
-    )
-    compare_parser.add_argument(
-        "--problems",
-        type=_problem_names,
-        default=list(PROBLEMS),
-        help=f"comma-separated problem names (default: all of {', '.join(PROBLEMS)})",
-    )
-    compare_parser.add_argument(
-        "--seed", type=_seed, default=None, help="OMPL's global random seed, for a reproducible comparison"
-    )
-    compare_parser.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
+
+    compare = commands.add_parser("compare", help="compare planners with stock RRTConnect on the built-in problems",
+                                  description=__doc__.split("\n\n", 1)[1])
+    compare.add_argument("--runs", type=_positive_int, default=20, help="runs per planner and problem (default 20)")
+    compare.add_argument("--time-limit", type=_positive_float, default=5.0, help="seconds each run may plan (default 5)")
+    compare.add_argument("--problems", type=_problem_names, default=list(PROBLEMS),
+                         help=f"comma-separated problem names (default: all of {', '.join(PROBLEMS)})")
+    compare.add_argument("--planners", type=_planners, default=None,
+                         help="comma-separated planners: stock OMPL names (RRTConnect, RRT, PRM, ...), this package's "
+                              "planners and presets, each optionally NAME[param=value;...] (default: RRTConnect, "
+                              "BalancedRRTConnect, BalancedRRTConnect[balance_tree_sizes=0])")
+    compare.add_argument("--seed", type=_positive_int, default=None,
+                         help="experiment seed; every run's seed derives from it (default: drawn and printed)")
+    compare.add_argument("-o", "--out", type=Path, default=None, help="keep results, logs and database in this folder")
+    _add_execution_options(compare)
+
+    bench_parser = commands.add_parser("bench", help="run an experiment file into an output folder (resumes)")
+    bench_parser.add_argument("experiment", type=Path, help="experiment TOML file (see docs/benchmark.md)")
+    bench_parser.add_argument("-o", "--out", type=Path, required=True, help="output folder")
+    _add_execution_options(bench_parser)
+
+    plot = commands.add_parser("plot", help="plots and summary tables of an output folder (matplotlib)")
+    plot.add_argument("out", type=Path, help="output folder of bench or compare -o")
+    plot.add_argument("--baseline", default=None, help="planner label the ratios refer to (default: the experiment's)")
+    plot.add_argument("--tree-iterations", type=_positive_int, default=300,
+                      help="iterations at which the 2-D tree pictures are drawn (default 300)")
+
+    # Listed for --help; main() hands `gamma ...` to occupancy.gamma_command, which parses its own options.
+    commands.add_parser("gamma", add_help=False, help="estimate RRT*'s ball-radius constant (ompl-balance gamma --help)")
     return parser
 
 
+def _run(experiment: Experiment, out: Path, args: argparse.Namespace) -> int:
+    records = bench(experiment, out, jobs=args.jobs, dask=args.dask, progress=not args.no_progress)
+    print((out / "summary.md").read_text(), end="")
+    crashed = sum(bool(r["error"]) for r in records)
+    print(f"\n{len(records)} runs in {out}" + (f", {crashed} crashed or killed (see results.jsonl)" if crashed else ""))
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["gamma"]:
+        from .occupancy import gamma_command
+
+        return gamma_command(argv[1:])
     args = build_parser().parse_args(argv)
-    if args.seed is not None:
-        ou.RNG.setSeed(args.seed)  # must happen before OMPL draws its first random number
     ou.setLogLevel(ou.LOG_WARN)
-    if args.command == "compare":
-        problems = [get_problem(name) for name in args.problems]
-        results = compare(problems, default_planners(), args.runs, args.time_limit, progress=not args.no_progress)
-        print(format_table(summarize(results)))
+    try:
+        if args.command == "compare":
+            experiment = compare_experiment(args.problems, args.planners, args.runs, args.time_limit, args.seed)
+            print(f"experiment seed {experiment.seed}")
+            if args.out is not None:
+                return _run(experiment, args.out, args)
+            with tempfile.TemporaryDirectory(prefix="ompl-balance-compare-") as out:
+                return _run(experiment, Path(out), args)
+        if args.command == "bench":
+            return _run(load_experiment(args.experiment), args.out, args)
+        if args.command == "plot":
+            from .plots import plot_folder
+
+            for path in plot_folder(args.out, baseline=args.baseline, tree_iterations=args.tree_iterations):
+                print(path)
+            return 0
+    except ExperimentError as error:
+        print(f"ompl-balance {args.command}: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("\ninterrupted: finished runs are kept; run the same command again to resume", file=sys.stderr)
+        return 130
     return 0
 
 

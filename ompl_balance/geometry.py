@@ -6,7 +6,7 @@ The collision layer needs it three ways:
 * as an FCL geometry for the exact test (:meth:`Shape.fcl_geometry`; meshes become
   ``fcl.BVHModel``, primitives FCL's own shapes),
 * as a trimesh mesh (:meth:`Shape.trimesh`), for bounds and for independent checks,
-* as cheap bounding volumes for the numpy pre-filter: a few spheres covering the shape
+* as cheap bounding volumes for the numpy pre-filter: spheres covering the shape
   (:meth:`Shape.bounding_spheres`, for robot links) or one oriented box around it
   (:meth:`Shape.bounding_box`, for obstacles).
 
@@ -17,6 +17,7 @@ suffices; for primitives (solids in FCL) the spheres cover the whole solid.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 
 import fcl
@@ -24,6 +25,8 @@ import numpy as np
 import trimesh
 
 SHAPE_KINDS = ("box", "sphere", "cylinder", "mesh")
+
+_SPHERES_OF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # Shape -> {count: (centres, radii)}
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,35 +111,78 @@ class Shape:
     def bounding_spheres(self, count: int) -> tuple[np.ndarray, np.ndarray]:
         """At most ``count`` spheres covering the shape: ``(centres (m, 3), radii (m,))``, shape frame.
 
-        The shape is cut into ``count`` slabs along its longest axis and each slab gets
-        the smallest sphere about the slab's centre that holds it (for meshes: every
-        vertex of the triangles whose centroid falls in the slab, hence every triangle).
+        Starting from one piece (the whole shape), the piece with the largest sphere is
+        cut in two across its longest extent until there are ``count`` pieces: boxes and
+        cylinders are cut as boxes (a cylinder through its bounding box), meshes as sets of
+        triangles split at the median centroid (long triangles are subdivided first, to
+        edges of at most 1/count of the mesh's radius, covering the same surface). Each piece gets the sphere about its box
+        centre that holds it; for meshes, every vertex of the piece's triangles (FCL tests
+        a mesh's triangles, so covering every triangle covers what FCL can touch).
         """
+        if count < 1:
+            raise ValueError(f"bounding_spheres needs count >= 1, got {count}")
+        known = _SPHERES_OF.setdefault(self, {})  # robots share shapes across checkers; compute once
+        if count not in known:
+            centres, radii = self._covering_spheres(count)
+            centres.setflags(write=False)
+            radii.setflags(write=False)
+            known[count] = centres, radii
+        return known[count]
+
+    def _covering_spheres(self, count: int) -> tuple[np.ndarray, np.ndarray]:
         if self.kind == "sphere":
             return np.zeros((1, 3)), np.array([self.dims[0]])
-        if self.kind in ("box", "cylinder"):
-            pose, half = self.bounding_box()
-            axis = int(np.argmax(half))
-            step = 2.0 * half[axis] / count
-            centres = np.zeros((count, 3))
-            centres[:, axis] = -half[axis] + step * (np.arange(count) + 0.5)
-            slab = half.copy()
-            slab[axis] = 0.5 * step  # a cylinder is covered through its bounding box's slabs
-            return centres, np.full(count, np.linalg.norm(slab))
-        triangles = np.asarray(self.mesh.triangles)  # (f, 3, 3)
-        centroids = triangles.mean(axis=1)
-        vertices = triangles.reshape(-1, 3)
-        _, _, axes = np.linalg.svd(vertices - vertices.mean(axis=0), full_matrices=False)
-        along = centroids @ axes[0]
-        edges = np.linspace(along.min(), along.max(), count + 1)
-        slab_of = np.clip(np.searchsorted(edges, along, side="right") - 1, 0, count - 1)
-        centres, radii = [], []
-        for k in np.unique(slab_of):
-            points = triangles[slab_of == k].reshape(-1, 3)
-            centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
-            centres.append(centre)
-            radii.append(np.sqrt(((points - centre) ** 2).sum(axis=1).max()))
-        return np.array(centres), np.array(radii)
+        if self.kind == "mesh":
+            # cut long triangles first (the pieces cover the same surface) so spheres can shrink
+            whole = _TrianglePiece(np.asarray(self.mesh.triangles, dtype=float))
+            vertices, faces = trimesh.remesh.subdivide_to_size(
+                self.mesh.vertices, self.mesh.faces, max_edge=whole.radius / count, max_iter=20)
+            pieces = [_TrianglePiece(np.asarray(vertices, dtype=float)[faces])]
+        else:
+            pose, half = self.bounding_box()  # identity pose for box and cylinder
+            pieces = [_BoxPiece(np.zeros(3), np.asarray(half, dtype=float))]
+        while len(pieces) < count:
+            widest = max(range(len(pieces)), key=lambda i: pieces[i].radius)
+            halves = pieces[widest].split()
+            if halves is None:  # a single triangle: nothing left to cut
+                break
+            pieces[widest:widest + 1] = halves
+        return np.array([p.centre for p in pieces]), np.array([p.radius for p in pieces])
+
+
+class _BoxPiece:
+    """An axis-aligned box ``centre`` (3,) +- ``half`` (3,) and its circumscribed sphere."""
+
+    def __init__(self, centre: np.ndarray, half: np.ndarray):
+        self.centre, self.half = centre, half
+        self.radius = float(np.linalg.norm(half))
+
+    def split(self) -> list[_BoxPiece]:
+        axis = int(np.argmax(self.half))
+        half = self.half.copy()
+        half[axis] *= 0.5
+        step = np.zeros(3)
+        step[axis] = half[axis]
+        return [_BoxPiece(self.centre - step, half), _BoxPiece(self.centre + step, half)]
+
+
+class _TrianglePiece:
+    """Triangles (t, 3, 3) and the sphere about their vertices' box centre holding every vertex."""
+
+    def __init__(self, triangles: np.ndarray):
+        self.triangles = triangles
+        points = triangles.reshape(-1, 3)
+        self.centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+        self.radius = float(np.sqrt(((points - self.centre) ** 2).sum(axis=1).max()))
+
+    def split(self) -> list[_TrianglePiece] | None:
+        if len(self.triangles) < 2:
+            return None
+        centroids = self.triangles.mean(axis=1)
+        axis = int(np.argmax(np.ptp(centroids, axis=0)))
+        order = np.argsort(centroids[:, axis], kind="stable")
+        middle = len(order) // 2
+        return [_TrianglePiece(self.triangles[order[:middle]]), _TrianglePiece(self.triangles[order[middle:]])]
 
 
 def pose_matrix(position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> np.ndarray:

@@ -117,13 +117,22 @@ class RobotModel:
         self._offset = np.array([j.offset for j in joints]).reshape(-1, 4, 4)
         self._axis = np.array([j.axis for j in joints]).reshape(-1, 3)
         self._parent_body = [j.parent_body for j in joints]
-        self._revolute = np.array([j.kind == "revolute" for j in joints], dtype=float)[:, None, None]
-        self._prismatic = np.array([j.kind == "prismatic" for j in joints], dtype=float)[:, None]
-        # Rodrigues: R = I + sin(a) K + (1 - cos(a)) K^2 with K the cross-product matrix of the axis
+        # Each joint's transform parent body -> child body is offset @ motion(value). With K the
+        # cross-product matrix of the axis, a revolute motion rotates by I + sin(v) K + (1 - cos(v)) K^2
+        # (Rodrigues), so the rotation block is  R_off (I + K^2) + sin(v) R_off K - cos(v) R_off K^2;
+        # a prismatic one keeps R_off and moves the origin by v R_off axis.
+        revolute = np.array([j.kind == "revolute" for j in joints], dtype=float)[:, None, None]
         x, y, z = self._axis.T
         zero = np.zeros_like(x)
-        self._cross = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1).reshape(-1, 3, 3)
-        self._cross2 = self._cross @ self._cross
+        cross = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1).reshape(-1, 3, 3)
+        rotation = self._offset[:, :3, :3]
+        self._rotation_fixed = rotation + revolute * (rotation @ cross @ cross)
+        self._rotation_sin = revolute * (rotation @ cross)
+        self._rotation_cos = revolute * (rotation @ cross @ cross)
+        self._slide = (1.0 - revolute[:, :, 0]) * (rotation @ self._axis[:, :, None])[:, :, 0]  # (joints, 3)
+        self._has_prismatic = bool(self._slide.any())
+        self._direct = (np.array_equal(self._source, np.arange(self.dof)) and not self._shift.any()
+                        and np.all(self._multiplier == 1.0))  # joint values are q itself
         self._link_body = np.array(link_body)
         self._link_offset = np.array(link_offset)
         self.link_index = {n: i for i, n in enumerate(self.link_names)}
@@ -184,27 +193,33 @@ class RobotModel:
         q2 = q.reshape(1, -1) if q.ndim == 1 else q
         if q2.ndim != 2 or q2.shape[1] != self.dof:
             raise ValueError(f"configurations must have shape (n, {self.dof}) for joints {self.joint_names}, got {q.shape}")
-        bad = ~np.isfinite(q2)
-        if bad.any():
-            row, col = np.argwhere(bad)[0]
+        if not np.isfinite(q2).all():
+            row, col = np.argwhere(~np.isfinite(q2))[0]
             raise ValueError(f"configuration {row} has non-finite value {q2[row, col]} for joint {self.joint_names[col]!r}")
         return q2
 
     def body_poses(self, q) -> np.ndarray:
         """World poses of the bodies, (n, bodies, 4, 4), for configurations ``q`` (n, dof)."""
         q = self.as_array(q)
-        values = q[:, self._source] * self._multiplier + self._shift  # (n, moving joints)
-        # each moving joint's transform parent body -> child body: offset @ motion(value)
-        motion = np.broadcast_to(np.eye(4), values.shape + (4, 4)).copy()
-        s, c = np.sin(values)[..., None, None], np.cos(values)[..., None, None]
-        motion[..., :3, :3] += self._revolute * (s * self._cross + (1.0 - c) * self._cross2)
-        motion[..., :3, 3] += self._prismatic * values[..., None] * self._axis
-        local = self._offset @ motion
-        poses = np.empty((len(q), self.body_count, 4, 4))
-        poses[:, 0] = np.eye(4)
-        for k, parent in enumerate(self._parent_body, start=1):
-            poses[:, k] = poses[:, parent] @ local[:, k - 1]
-        return poses
+        values = q if self._direct else q[:, self._source] * self._multiplier + self._shift  # (n, joints)
+        sin, cos = np.sin(values)[..., None, None], np.cos(values)[..., None, None]
+        local = np.empty(values.shape + (4, 4))  # (n, joints, 4, 4)
+        local[..., :3, :3] = self._rotation_fixed + sin * self._rotation_sin - cos * self._rotation_cos
+        local[..., :3, 3] = self._offset[:, :3, 3]
+        if self._has_prismatic:
+            local[..., :3, 3] += values[..., None] * self._slide
+        local[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+        # down the tree, parents first; one state uses 2-D products (numpy's batched matmul
+        # costs twice as much per call, and OMPL checks states one at a time)
+        if len(q) == 1:
+            bodies = [np.eye(4)]
+            for transform, parent in zip(local[0], self._parent_body):
+                bodies.append(bodies[parent].dot(transform))
+            return np.stack(bodies)[None]
+        bodies = [np.broadcast_to(np.eye(4), (len(q), 4, 4))]
+        for k, parent in enumerate(self._parent_body):
+            bodies.append(bodies[parent] @ local[:, k])
+        return np.stack(bodies, axis=1)
 
     def fk(self, q) -> np.ndarray:
         """World poses of all links, (n, links, 4, 4), in :attr:`link_names` order.

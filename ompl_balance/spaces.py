@@ -28,6 +28,7 @@ from ompl import base as ob
 from .trees import ArrayTree, StateTree
 
 _SAMPLE_BLOCK = 256  # uniform samples drawn from numpy at a time
+_EQUAL_TOLERANCE = 2.0 * float(np.finfo(float).eps)
 
 
 class RealVectorPoints:
@@ -71,8 +72,12 @@ class RealVectorPoints:
 
     @staticmethod
     def equal(a: np.ndarray, b: np.ndarray) -> bool:
-        # OMPL's RealVectorStateSpace::equalStates tolerance
-        return bool(np.all(np.abs(a - b) <= 2.0 * np.finfo(float).eps))
+        """Equal within OMPL's ``RealVectorStateSpace::equalStates`` tolerance."""
+        return float(np.abs(a - b).max()) <= _EQUAL_TOLERANCE
+
+    def is_finite(self, state: ob.State) -> bool:
+        """``False`` when an OMPL state has a NaN or infinite value (bounds checks miss NaN)."""
+        return all(math.isfinite(value) for value in state[0 : self.dim])
 
     def from_state(self, state: ob.State) -> np.ndarray:
         """A copy of an OMPL state's values, ``(dim,)``."""
@@ -121,6 +126,14 @@ class StatePoints:
         state = self._si.allocState()
         self._space.interpolate(a, b, t, state)
         return state
+
+    def is_finite(self, state: ob.State) -> bool:
+        """``False`` when an OMPL state has a NaN or infinite value.
+
+        Any such value makes the state's distance to itself NaN (or infinite), in every
+        OMPL space, which bounds checks alone miss.
+        """
+        return math.isfinite(self.distance(state, state))
 
     def from_state(self, state: ob.State) -> ob.State:
         return self.new_state(state)

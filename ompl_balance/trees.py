@@ -15,6 +15,8 @@ a path is read off by following parents. Node ``i`` is the ``i``-th state added.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from ompl import base as ob
 
@@ -55,8 +57,27 @@ class _Links:
             nodes.append(int(self.parents[nodes[-1]]))
         return nodes
 
+    def reparent(self, subtree: np.ndarray, parent: int) -> None:
+        """Hang a subtree under ``parent`` (RRT* rewiring).
+
+        ``subtree``: indices of the subtree's top node (first) and all its descendants;
+        their roots become ``parent``'s root.
+        """
+        self.parents[subtree[0]] = parent
+        self.roots[subtree] = self.roots[parent]
+
+    def near(self, state, radius: float) -> tuple[np.ndarray, np.ndarray]:
+        """Indices of the nodes within ``radius`` of ``state`` (exact) and their distances."""
+        distances = self.distances(state)
+        within = np.flatnonzero(distances <= radius)
+        return within, distances[within]
+
     def clear(self) -> None:
         self.size = 0
+
+
+_EPS = float(np.finfo(float).eps)
+_BRUTE_FORCE_SIZE = 256  # below this, plain squared distances beat the matrix-vector ranking
 
 
 class ArrayTree(_Links):
@@ -65,6 +86,8 @@ class ArrayTree(_Links):
     def __init__(self, dim: int, capacity: int = 1024) -> None:
         super().__init__(capacity)
         self._states = np.empty((capacity, dim))
+        self._squared_norms = np.empty(capacity)  # |state|^2 per node, for nearest()
+        self._largest_norm = 0.0
 
     @property
     def states(self) -> np.ndarray:
@@ -79,15 +102,41 @@ class ArrayTree(_Links):
         index = self._link(parent)
         if index == len(self._states):
             self._states = np.concatenate([self._states, np.empty_like(self._states)])
+            self._squared_norms = np.concatenate([self._squared_norms, np.empty_like(self._squared_norms)])
         self._states[index] = state
+        squared_norm = float(state @ state)
+        self._squared_norms[index] = squared_norm
+        self._largest_norm = max(self._largest_norm, math.sqrt(squared_norm))
         return index
 
     def nearest(self, state: np.ndarray) -> tuple[int, float]:
-        """Index of the node closest to ``state`` (Euclidean) and its distance."""
+        """Index of the node closest to ``state`` (Euclidean) and its distance (exact).
+
+        Small trees: squared distances of all nodes. Larger trees: nodes ranked by
+        ``|s|^2 - 2 s.q`` (one matrix-vector product, fewer temporaries), with
+        near-ties within that expansion's rounding error settled by exact distances.
+        """
+        states = self._states[: self.size]
+        if self.size <= _BRUTE_FORCE_SIZE:
+            offsets = states - state
+            squared = np.einsum("ij,ij->i", offsets, offsets)
+            index = int(squared.argmin())
+            return index, math.sqrt(squared[index])
+        scores = self._squared_norms[: self.size] - 2.0 * (states @ state)
+        index = int(scores.argmin())
+        reach = self._largest_norm + math.sqrt(float(state @ state))
+        near_ties = scores <= scores[index] + 16.0 * len(state) * _EPS * reach * reach
+        if np.count_nonzero(near_ties) > 1:
+            ties = near_ties.nonzero()[0]
+            offsets = states[ties] - state
+            index = int(ties[np.einsum("ij,ij->i", offsets, offsets).argmin()])
+        offset = states[index] - state
+        return index, math.sqrt(float(offset @ offset))
+
+    def distances(self, state: np.ndarray) -> np.ndarray:
+        """Euclidean distance from every node to ``state``, ``(len(tree),)``."""
         offsets = self._states[: self.size] - state
-        squared = np.einsum("ij,ij->i", offsets, offsets)
-        index = int(squared.argmin())
-        return index, float(np.sqrt(squared[index]))
+        return np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
 
 
 class StateTree(_Links):
@@ -119,6 +168,11 @@ class StateTree(_Links):
         distances = [distance(node, state) for node in self._states]
         index = int(np.argmin(distances))
         return index, distances[index]
+
+    def distances(self, state: ob.State) -> np.ndarray:
+        """``si.distance`` from every node to ``state``, ``(len(tree),)``."""
+        distance = self._distance
+        return np.array([distance(node, state) for node in self._states], dtype=float)
 
     def clear(self) -> None:
         super().clear()

@@ -119,7 +119,7 @@ class CollisionChecker:
     """
 
     def __init__(self, robot: RobotModel, environment: Environment | None = None,
-                 spheres_per_geometry: int = 4, prefilter: bool = True):
+                 spheres_per_geometry: int = 8, prefilter: bool = True):
         self.robot = robot
         self.environment = environment or Environment()
         self.prefilter = prefilter
@@ -129,6 +129,7 @@ class CollisionChecker:
 
         self._geometry_body = np.array([g.body for g in geometries], dtype=int)
         self._geometry_origin = np.array([g.origin for g in geometries]).reshape(-1, 4, 4)
+        self._origin_is_identity = [bool(np.array_equal(g.origin, np.eye(4))) for g in geometries]
         self._links = [fcl.CollisionObject(g.shape.fcl_geometry(), fcl.Transform()) for g in geometries]
         self._obstacles = [fcl.CollisionObject(o.shape.fcl_geometry(), fcl_transform(o.pose)) for o in obstacles]
         self._pairs = np.array(robot.self_collision_pairs, dtype=int).reshape(-1, 2)
@@ -136,38 +137,44 @@ class CollisionChecker:
         self._environment_manager.registerObjects(self._obstacles)
         self._environment_manager.setup()
 
-        # pre-filter: link spheres (in body frames) grouped by geometry, obstacle boxes
-        centres, radii, owner = [], [], []
-        for index, g in enumerate(geometries):
-            c, r = g.shape.bounding_spheres(spheres_per_geometry)
-            centres.append(c @ g.origin[:3, :3].T + g.origin[:3, 3])
-            radii.append(r)
-            owner.append(np.full(len(r), index))
-        centres = np.concatenate(centres).reshape(-1, 3)
-        self._sphere_centre = np.hstack([centres, np.ones((len(centres), 1))])[:, :, None]  # (spheres, 4, 1)
-        self._sphere_radius = np.concatenate(radii) if radii else np.zeros(0)
-        owner = np.concatenate(owner) if owner else np.zeros(0, dtype=int)
-        self._sphere_body = self._geometry_body[owner]
-        self._sphere_starts = np.searchsorted(owner, np.arange(len(geometries)))  # spheres are sorted by owner
-        # a point p is in box o's frame at p @ R_o - c_o @ R_o; all boxes in one product
-        boxes = [o.shape.bounding_box() for o in obstacles]
-        box_pose = np.array([o.pose @ pose for o, (pose, _) in zip(obstacles, boxes)]).reshape(-1, 4, 4)
-        self._box_axes = np.concatenate(list(box_pose[:, :3, :3]), axis=1) if boxes else np.zeros((3, 0))
-        self._box_offset = np.einsum("oi,oij->oj", box_pose[:, :3, 3], box_pose[:, :3, :3]).ravel()
-        self._box_half = np.array([half for _, half in boxes]).reshape(-1, 3)
-        # every sphere pair of every self-collision geometry pair, sorted by pair
-        ia, ib, pair_of = [], [], []
+        # pre-filter spheres, sorted by geometry. World centres (n, 3, spheres) come out of one
+        # product: body poses laid side by side (n, 3, 4 * bodies) @ body-frame centres placed in
+        # their body's rows of a (4 * bodies, spheres) matrix.
+        spheres = [g.shape.bounding_spheres(spheres_per_geometry) for g in geometries]
+        radius = np.concatenate([r for _, r in spheres]) if spheres else np.zeros(0)
+        owner = np.repeat(np.arange(len(geometries)), [len(r) for _, r in spheres]).astype(int)
+        self._geometry_starts = np.searchsorted(owner, np.arange(len(geometries)))
+        self._sphere_centre = np.zeros((4 * robot.body_count, len(radius)))
+        column = 0
+        for g, (centres, _) in zip(geometries, spheres):
+            for centre in centres @ g.origin[:3, :3].T + g.origin[:3, 3]:
+                self._sphere_centre[4 * g.body:4 * g.body + 4, column] = (*centre, 1.0)
+                column += 1
+        # obstacles: the six face planes of a box around each, face-major rows (face * obstacles + o):
+        # a sphere can touch box o only if  normal . centre - (normal . box centre + half) <= radius
+        # for all six faces, i.e. if the largest of  face @ centre + face_offset  is <= 0
+        normals, offsets = [], []
+        for side in (1.0, -1.0):
+            for axis in range(3):
+                for o in obstacles:
+                    box_pose, half = o.shape.bounding_box()
+                    pose = o.pose @ box_pose
+                    normal = side * pose[:3, axis]
+                    normals.append(normal)
+                    offsets.append(-(normal @ pose[:3, 3] + half[axis]))
+        self._face_normal = np.array(normals).reshape(-1, 3)
+        self._face_offset = (np.array(offsets)[:, None] - (radius + PREFILTER_SLACK)).reshape(6, len(obstacles), len(radius))
+        # self-collision: every sphere pair of every self-collision geometry pair, sorted by pair
+        pair_a, pair_b, pair_of = [], [], []
         for p, (a, b) in enumerate(self._pairs):
             sa, sb = np.flatnonzero(owner == a), np.flatnonzero(owner == b)
-            ia.append(np.repeat(sa, len(sb)))
-            ib.append(np.tile(sb, len(sa)))
+            pair_a.append(np.repeat(sa, len(sb)))
+            pair_b.append(np.tile(sb, len(sa)))
             pair_of.append(np.full(len(sa) * len(sb), p))
-        self._pair_sphere_a = np.concatenate(ia).astype(int) if ia else np.zeros(0, dtype=int)
-        self._pair_sphere_b = np.concatenate(ib).astype(int) if ib else np.zeros(0, dtype=int)
-        pair_of = np.concatenate(pair_of) if pair_of else np.zeros(0, dtype=int)
-        self._pair_starts = np.searchsorted(pair_of, np.arange(len(self._pairs)))
-        self._pair_reach = (self._sphere_radius[self._pair_sphere_a] + self._sphere_radius[self._pair_sphere_b]
-                            + PREFILTER_SLACK) ** 2
+        self._pair_sphere_a = np.concatenate(pair_a) if pair_a else np.zeros(0, dtype=int)
+        self._pair_sphere_b = np.concatenate(pair_b) if pair_b else np.zeros(0, dtype=int)
+        self._pair_starts = np.searchsorted(np.concatenate(pair_of) if pair_of else [], np.arange(len(self._pairs)))
+        self._pair_reach = (radius[self._pair_sphere_a] + radius[self._pair_sphere_b] + PREFILTER_SLACK) ** 2
 
     # ------------------------------------------------------------------ public API
 
@@ -178,17 +185,25 @@ class CollisionChecker:
         poses = self.robot.body_poses(q)
         if not self.prefilter:
             return np.array([self._free_reference(p) for p in poses], dtype=bool)
-        env_candidates, self_candidates = self._candidates(poses)
-        valid = np.ones(len(q), dtype=bool)
-        for i in np.flatnonzero(env_candidates.any(axis=(1, 2)) | self_candidates.any(axis=1)):
-            valid[i] = self._free_exact(poses[i], env_candidates[i], self_candidates[i])
+        maybe, env, own = self._candidates(poses)
+        valid = ~maybe
+        for i in np.flatnonzero(maybe):
+            valid[i] = self._free_exact(poses[i], env[i], own[i])
         return valid
 
     def is_valid(self, q) -> bool:
         """Validity of one configuration ``q`` (dof,)."""
-        return bool(self.check(q)[0])
+        q = self.robot.as_array(q)
+        if len(q) != 1:
+            raise ValueError(f"is_valid takes one configuration of {self.robot.dof} joint values, got shape {q.shape}")
+        self.counter.states_checked += 1
+        poses = self.robot.body_poses(q)
+        if not self.prefilter:
+            return self._free_reference(poses[0])
+        maybe, env, own = self._candidates(poses)
+        return not maybe[0] or self._free_exact(poses[0], env[0], own[0])
 
-    def first_collision(self, q, order=None, first_chunk: int = 4) -> int:
+    def first_collision(self, q, order=None, first_chunk: int = 1) -> int:
         """Index of the first configuration in collision, visiting ``q`` (n, dof) in ``order``, or -1.
 
         The first ``first_chunk`` rows of ``order`` (default: row order) go through
@@ -206,9 +221,8 @@ class CollisionChecker:
             if not self.prefilter:
                 hit = next((k for k in range(len(chunk)) if not self._free_reference(poses[k])), -1)
             else:
-                env, own = self._candidates(poses)
-                maybe = np.flatnonzero(env.any(axis=(1, 2)) | own.any(axis=1))
-                hit = next((k for k in maybe if not self._free_exact(poses[k], env[k], own[k])), -1)
+                maybe, env, own = self._candidates(poses)
+                hit = next((k for k in np.flatnonzero(maybe) if not self._free_exact(poses[k], env[k], own[k])), -1)
             if hit >= 0:
                 return int(chunk[hit])
         return -1
@@ -221,47 +235,74 @@ class CollisionChecker:
 
     # ------------------------------------------------------------------ internals
 
-    def _candidates(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Pairs whose bounding volumes touch: ``(env (n, geometries, obstacles), self (n, pairs))`` bool."""
-        n, geometry_count, obstacle_count = len(poses), len(self._links), len(self._obstacles)
-        centres = (poses[:, self._sphere_body, :3, :] @ self._sphere_centre)[..., 0]  # (n, spheres, 3)
-        if obstacle_count and geometry_count:
-            local = (centres @ self._box_axes - self._box_offset).reshape(n, -1, obstacle_count, 3)
-            outside = np.maximum(np.abs(local) - self._box_half, 0.0)
-            near = (outside**2).sum(axis=-1) <= (self._sphere_radius[:, None] + PREFILTER_SLACK) ** 2
-            env = np.logical_or.reduceat(near, self._sphere_starts, axis=1)
+    def _candidates(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Which bounding spheres touch, for body ``poses`` (n, bodies, 4, 4).
+
+        Returns ``maybe`` (n,) bool, True where a sphere may touch an obstacle's box or a
+        sphere of a self-collision partner; ``env`` (n, obstacles, spheres) and ``own``
+        (n, sphere pairs) bool. Written for small arrays, where each numpy call costs about a
+        microsecond whatever its size: few calls, ``np.take`` rather than fancy indexing,
+        sums of slices rather than reductions along short axes.
+        """
+        n = len(poses)
+        side_by_side = poses[:, :, :3, :].transpose(0, 2, 1, 3).reshape(n, 3, -1)
+        centres = side_by_side @ self._sphere_centre  # (n, 3, spheres)
+        maybe = np.zeros(n, dtype=bool)
+        if len(self._obstacles):
+            height = (self._face_normal @ centres).reshape(n, *self._face_offset.shape) + self._face_offset
+            env = height.max(axis=1) <= 0.0  # (n, obstacles, spheres)
+            maybe |= env.reshape(n, -1).any(axis=1)
         else:
-            env = np.zeros((n, geometry_count, obstacle_count), dtype=bool)
+            env = np.zeros((n, 0, centres.shape[2]), dtype=bool)
         if len(self._pairs):
-            gap = centres[:, self._pair_sphere_a] - centres[:, self._pair_sphere_b]
-            near = (gap**2).sum(axis=-1) <= self._pair_reach
-            own = np.logical_or.reduceat(near, self._pair_starts, axis=1)
+            gap = np.take(centres, self._pair_sphere_a, axis=2) - np.take(centres, self._pair_sphere_b, axis=2)
+            gap *= gap
+            own = gap[:, 0] + gap[:, 1] + gap[:, 2] <= self._pair_reach
+            maybe |= own.any(axis=1)
         else:
             own = np.zeros((n, 0), dtype=bool)
-        return env, own
+        return maybe, env, own
 
-    def _place(self, body_poses: np.ndarray, geometries) -> None:
-        """Move the FCL objects of ``geometries`` to their poses for one configuration."""
-        poses = body_poses[self._geometry_body[geometries]] @ self._geometry_origin[geometries]
-        for g, pose in zip(geometries, poses):
-            self._links[g].setRotation(pose[:3, :3])
-            self._links[g].setTranslation(pose[:3, 3])
+    def _place(self, body_poses: np.ndarray, geometry: int) -> None:
+        """Move the FCL object of ``geometry`` to its pose for one configuration."""
+        pose = body_poses[self._geometry_body[geometry]]
+        if not self._origin_is_identity[geometry]:
+            pose = pose.dot(self._geometry_origin[geometry])
+        self._links[geometry].setRotation(pose[:3, :3])
+        self._links[geometry].setTranslation(pose[:3, 3])
 
     def _collide(self, a: fcl.CollisionObject, b: fcl.CollisionObject) -> bool:
         return fcl.collide(a, b, self._request, fcl.CollisionResult()) > 0
 
     def _free_exact(self, body_poses: np.ndarray, env: np.ndarray, own: np.ndarray) -> bool:
-        """FCL on the candidate pairs of one configuration; True if none collides."""
-        env_pairs = np.argwhere(env)
-        self_pairs = self._pairs[own]
-        self._place(body_poses, np.unique(np.concatenate([env_pairs[:, 0], self_pairs.ravel()])))
-        if any(self._collide(self._links[g], self._obstacles[o]) for g, o in env_pairs):
-            return False
-        return not any(self._collide(self._links[a], self._links[b]) for a, b in self_pairs)
+        """FCL on the pairs with touching spheres in one configuration; True if none collides.
+
+        ``env`` (obstacles, spheres) and ``own`` (sphere pairs) as from :meth:`_candidates`.
+        """
+        placed = set()
+
+        def place(geometry):
+            if geometry not in placed:
+                self._place(body_poses, geometry)
+                placed.add(geometry)
+
+        if env.any():
+            for o, g in np.argwhere(np.logical_or.reduceat(env, self._geometry_starts, axis=1)).tolist():
+                place(g)
+                if self._collide(self._links[g], self._obstacles[o]):
+                    return False
+        if own.any():
+            for a, b in self._pairs[np.logical_or.reduceat(own, self._pair_starts)].tolist():
+                place(a)
+                place(b)
+                if self._collide(self._links[a], self._links[b]):
+                    return False
+        return True
 
     def _free_reference(self, body_poses: np.ndarray) -> bool:
         """FCL without pre-filter: broad phase against the environment, then every self pair."""
-        self._place(body_poses, np.arange(len(self._links)))
+        for g in range(len(self._links)):
+            self._place(body_poses, g)
         for link in self._links:
             data = fcl.CollisionData(self._request, fcl.CollisionResult())
             self._environment_manager.collide(link, data, fcl.defaultCollisionCallback)
@@ -309,10 +350,11 @@ class MotionValidator(ob.MotionValidator):
 
     The edge ``s1 -> s2`` is cut into ``space.validSegmentCount(s1, s2)`` segments as
     OMPL's ``DiscreteMotionValidator`` does; the states at ``j / nd`` for
-    ``j = 1 .. nd`` (``s1`` is taken as valid) go through forward kinematics and the
-    pre-filter in two batches (the first few of the coarse-to-fine order, ``s2``, the
-    midpoint, the quarter points, ..., then the rest), and FCL runs on them in that order
-    until the first collision. Counts one motion and the states of the batches processed.
+    ``j = 1 .. nd`` (``s1`` is taken as valid) are visited in the coarse-to-fine order
+    ``s2``, the midpoint, the quarter points, ...: ``s2`` alone first on the single-state
+    path (it decides most colliding edges, as in OMPL's validator), then all the others in
+    one batch of forward kinematics and pre-filter, FCL running on them in that order until
+    the first collision. Counts one motion and the states of the batches processed.
     """
 
     def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker):
@@ -330,15 +372,20 @@ class MotionValidator(ob.MotionValidator):
         As OMPL's ``checkMotion(s1, s2, lastValid)`` overload (which the Python
         binding does not expose): on a collision the states are examined in order from
         ``s1``, ``t = (j - 1) / nd`` for the first invalid state ``j``, and ``last_valid``
-        (if given) is set to the state at ``t``. ``t = 1`` for a valid edge.
+        (if given) is set to the state at ``t``. ``t = 1`` for a valid edge, and whenever
+        ``last_valid`` is not given (then the states are visited coarse to fine instead).
         """
         a, b = np.array(s1[0:self._dof]), np.array(s2[0:self._dof])
         nd = self._space.validSegmentCount(s1, s2)
         self.checker.counter.motions_checked += 1
         t = np.arange(1, nd + 1) / nd
-        states = a + t[:, None] * (b - a)
         if last_valid is None:
-            return self.checker.first_collision(states, coarse_to_fine(nd)) < 0, 1.0
+            # s2 alone on the single-state path (it decides most colliding edges), then the rest
+            if not self.checker.is_valid(b):
+                return False, 1.0
+            states = a + t[:-1, None] * (b - a)
+            return nd == 1 or self.checker.first_collision(states, coarse_to_fine(nd)[1:], first_chunk=0) < 0, 1.0
+        states = a + t[:, None] * (b - a)
         first = self.checker.first_collision(states)
         if first < 0:
             return True, 1.0

@@ -24,8 +24,10 @@ def assert_fk_matches_yourdfpy(robot, urdf_path, root, count=40, seed=0):
     assert poses.shape == (count, len(robot.link_names), 4, 4)
     for i in range(count):
         urdf.update_cfg(dict(zip(robot.joint_names, q[i])))
+        single = robot.fk(q[i])[0]  # one configuration takes its own path (2-D products)
         for k, link in enumerate(robot.link_names):
             np.testing.assert_allclose(poses[i, k], urdf.get_transform(link, root), atol=1e-9, rtol=0)
+            np.testing.assert_allclose(single[k], urdf.get_transform(link, root), atol=1e-9, rtol=0)
 
 
 def test_arm3_model():
@@ -47,7 +49,7 @@ def test_fk_matches_yourdfpy_arm3():
 def test_fk_single_configuration_and_batch_agree():
     robot = load_arm3()
     q = np.random.default_rng(3).uniform(robot.lower, robot.upper, size=(7, robot.dof))
-    np.testing.assert_array_equal(robot.fk(q)[2], robot.fk(q[2])[0])
+    np.testing.assert_allclose(robot.fk(q)[2], robot.fk(q[2])[0], atol=1e-12, rtol=0)
 
 
 @pytest.mark.skipif(not PANDA_VAMP.is_dir(), reason=f"shared data not found at {PANDA_VAMP}")

@@ -188,6 +188,30 @@ def test_solves_se2_through_ompl_states():
     assert data.numVertices() == planner.stats.start_tree_size + planner.stats.goal_tree_size
 
 
+def test_solves_se3_around_a_ball():
+    space = ob.SE3StateSpace()
+    bounds = ob.RealVectorBounds(3)
+    bounds.setLow(-1.0)
+    bounds.setHigh(1.0)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+
+    def is_valid(state):
+        return state.getX() ** 2 + state.getY() ** 2 + state.getZ() ** 2 > 0.5**2
+
+    ss.setStateValidityChecker(is_valid)
+    start, goal = space.allocState(), space.allocState()
+    start.setXYZ(-0.8, 0.0, 0.0)
+    start.rotation().setIdentity()
+    goal.setXYZ(0.8, 0.0, 0.0)
+    goal.rotation().setAxisAngle(0.0, 0.0, 1.0, math.pi / 2)
+    ss.setStartAndGoalStates(start, goal)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert_valid_solution(ss, is_valid, [start], goal_test_for(ss))
+
+
 def test_solve_called_directly_with_seconds():
     problem = get_problem("narrow_gap")
     ss = problem.setup()
@@ -257,6 +281,15 @@ def test_start_in_collision_is_invalid_start():
     space = ss.getStateSpace()
     start = space.allocState()
     start[0], start[1] = 0.5, 0.2  # inside the wall
+    ss.setStartState(start)
+    assert status_of(ss, BalancedRRTConnect(ss.getSpaceInformation())) == ob.PlannerStatus.INVALID_START
+
+
+@pytest.mark.parametrize("values", [(float("nan"), 0.5), (1.5, 0.5), (-0.1, 0.5)])
+def test_start_not_finite_or_outside_bounds_is_invalid_start(values):
+    ss = get_problem("open").setup()
+    start = ss.getStateSpace().allocState()
+    start[0], start[1] = values
     ss.setStartState(start)
     assert status_of(ss, BalancedRRTConnect(ss.getSpaceInformation())) == ob.PlannerStatus.INVALID_START
 
@@ -345,6 +378,15 @@ ROUND_TRIPS = {
     "balance_tree_sizes": ("0", "0"),
     "max_tree_size_ratio": ("2.5", "2.5"),
     "seed": ("42", "42"),
+    # the classroom-variant policies (issue #6; tests/test_variants.py)
+    "swap_policy": ("on_collision", "on_collision"),
+    "swap_steps": ("7", "7"),
+    "nearest_policy": ("exhaustion", "exhaustion"),
+    "exhausted_after": ("3", "3"),
+    "exhaustion_target": ("4", "4"),
+    "sample_policy": ("goal_ball", "goal_ball"),
+    "goal_bias": ("0.25", "0.25"),
+    "min_quality": ("0.1", "0.1"),
 }
 
 

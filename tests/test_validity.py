@@ -5,6 +5,7 @@ from pathlib import Path
 import fcl
 import numpy as np
 import pytest
+import trimesh
 import yourdfpy
 from ompl import base as ob
 from ompl import geometric as og
@@ -70,6 +71,8 @@ def check_scene(scene, count, seed):
     expected = ~(env_hits | self_hits)
     np.testing.assert_array_equal(CollisionChecker(robot, environment).check(q), expected)
     np.testing.assert_array_equal(CollisionChecker(robot, environment, spheres_per_geometry=1).check(q), expected)
+    one_by_one = CollisionChecker(robot, environment, spheres_per_geometry=16)  # single-state path, many spheres
+    np.testing.assert_array_equal([one_by_one.is_valid(x) for x in q[:80]], expected[:80])
     np.testing.assert_array_equal(CollisionChecker(robot, environment, prefilter=False).check(q), expected)
     self_only = CollisionChecker(robot)
     np.testing.assert_array_equal(self_only.check(q), ~self_hits)
@@ -82,6 +85,22 @@ def test_collisions_agree_with_independent_fcl_arm3():
 @needs_data
 def test_collisions_agree_with_independent_fcl_panda_table_pick():
     check_scene(panda_scene(), 250, seed=2)
+
+
+@pytest.mark.parametrize("count", [1, 3, 8, 32])
+def test_bounding_spheres_cover_every_surface_point(count):
+    robot, environment, _ = arm3_scene()
+    shapes = [g.shape for g in robot.geometries] + [o.shape for o in environment.obstacles]
+    assert {s.kind for s in shapes} == {"box", "sphere", "cylinder", "mesh"}
+    for shape in shapes:
+        centres, radii = shape.bounding_spheres(count)
+        assert 1 <= len(radii) <= count
+        mesh = shape.trimesh()
+        points = np.vstack([mesh.vertices, trimesh.sample.sample_surface(mesh, 2000, seed=5)[0]])
+        if shape.kind != "mesh":  # FCL primitives are solids: the inside must be covered too
+            points = np.vstack([points, trimesh.sample.volume_mesh(mesh, 2000)])
+        gap = np.linalg.norm(points[:, None] - centres[None], axis=-1) - radii
+        assert gap.min(axis=1).max() <= 1e-9, f"{shape.kind}: a point is outside every sphere"
 
 
 def make_si(robot, checker, resolution=0.01):

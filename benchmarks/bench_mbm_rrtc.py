@@ -1,0 +1,110 @@
+"""Stock og.RRTConnect and BalancedRRTConnect on MotionBenchMaker Panda problems, one run.
+
+Both planners run through ``og.SimpleSetup`` with the package's collision checker and
+batched motion validator (``setup_robot``) on the four dev scenarios (table_pick,
+table_under_pick, box, bookshelf_small), VAMP's Panda model, all of a problem's goals
+as ``ob.GoalStates`` (any goal is a success). Per scenario and planner it prints the
+success rate, the median time (failed runs count with the time they took, i.e. the
+limit), the median states checked and motions checked, and their ratios to stock
+RRTConnect. Planners alternate problem by problem so the machine's slow phases hit both.
+Every returned path is re-checked state by state with a fresh checker.
+
+Run: ``python benchmarks/bench_mbm_rrtc.py [--data DIR] [--problems 10] [--time-limit 10]``
+(DIR defaults to ``<repo>/../shared/data``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from ompl_balance import BalancedRRTConnect
+from ompl_balance.counting import read_work
+from ompl_balance.mbm import load_mbm
+from ompl_balance.robots import load_panda_vamp
+from ompl_balance.validity import CollisionChecker, setup_robot, space_for
+
+SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small")
+PLANNERS = {"RRTConnect": og.RRTConnect, "BalancedRRTConnect": BalancedRRTConnect}
+
+
+def solve(robot, problem, make_planner, time_limit: float) -> dict:
+    """One planning run; returns success, seconds, work counts and whether the path re-checks valid."""
+    ss = og.SimpleSetup(space_for(robot))
+    checker = CollisionChecker(robot, problem.environment)
+    setup_robot(ss, checker)
+    si = ss.getSpaceInformation()
+    start = si.allocState()
+    for i, value in enumerate(problem.start):
+        start[i] = float(value)
+    ss.setStartState(start)
+    goals = ob.GoalStates(si)
+    for configuration in problem.goals:
+        goal = si.allocState()
+        for i, value in enumerate(configuration):
+            goal[i] = float(value)
+        goals.addState(goal)
+    ss.setGoal(goals)
+    ss.setPlanner(make_planner(si))
+    ss.setup()
+    before = read_work(si)
+    began = time.perf_counter()
+    ss.solve(time_limit)
+    elapsed = time.perf_counter() - began
+    work = read_work(si) - before
+    solved = bool(ss.haveExactSolutionPath())
+    path_valid = None
+    if solved:
+        path = ss.getSolutionPath()
+        path.interpolate()  # states at the space's validity-checking resolution
+        states = np.array([path.getState(i)[0:robot.dof] for i in range(path.getStateCount())])
+        path_valid = bool(CollisionChecker(robot, problem.environment).check(states).all())
+    return {"solved": solved, "time": elapsed, "checks": work.states_checked,
+            "motions": work.motions_checked, "path_valid": path_valid}
+
+
+def main() -> None:
+    repo = Path(__file__).resolve().parents[1]
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data", type=Path, default=repo.parent / "shared" / "data")
+    parser.add_argument("--problems", type=int, default=10, help="first N problems of each scenario (default 10)")
+    parser.add_argument("--time-limit", type=float, default=10.0, help="seconds per run (default 10)")
+    parser.add_argument("--scenarios", default=",".join(SCENARIOS), help="comma-separated subset of " + ", ".join(SCENARIOS))
+    args = parser.parse_args()
+    ou.RNG.setSeed(1)
+    ou.setLogLevel(ou.LOG_WARN)
+    robot = load_panda_vamp(args.data / "robots" / "panda_vamp")
+
+    print(f"Panda (VAMP model), first {args.problems} problems per scenario, one run each, time limit "
+          f"{args.time_limit:g} s; ratios are to stock RRTConnect's medians\n")
+    print("| scenario | planner | success | median time (ms) | median states checked | median motions "
+          "| time ratio | checks ratio |")
+    print("|---|---|---|---|---|---|---|---|")
+    for scenario in args.scenarios.split(","):
+        problems = load_mbm(args.data / "mbm" / "panda" / f"{scenario}.json", robot.joint_names)[: args.problems]
+        results = {name: [] for name in PLANNERS}
+        for problem in problems:
+            for name, make_planner in PLANNERS.items():
+                result = solve(robot, problem, make_planner, args.time_limit)
+                if result["path_valid"] is False:
+                    raise AssertionError(f"{scenario} problem {problem.id}: {name} returned a path in collision")
+                results[name].append(result)
+        medians = {name: {key: statistics.median(r[key] for r in runs) for key in ("time", "checks", "motions")}
+                   for name, runs in results.items()}
+        stock = medians["RRTConnect"]
+        for name, runs in results.items():
+            m = medians[name]
+            success = sum(r["solved"] for r in runs) / len(runs)
+            print(f"| {scenario} | {name} | {success:.0%} | {m['time'] * 1e3:.0f} | {m['checks']:.0f} | {m['motions']:.0f} "
+                  f"| {m['time'] / stock['time']:.2f} | {m['checks'] / max(stock['checks'], 1):.2f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()

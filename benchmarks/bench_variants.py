@@ -1,0 +1,179 @@
+"""The classroom RRT-Connect variants (PRESETS) against stock og.RRTConnect, in one run.
+
+Per problem and planner: success, median time, median collision queries (states the
+validity checker decided, including those inside motion checks and inside a valid-state
+sampler: one counter, no double counting), median nodes (both trees; stock's from
+``getPlannerData``), each with its ratio to stock RRTConnect's median in the same run.
+Runs are interleaved (run i of every planner, then run i + 1) so slow phases of the
+shared machine hit all planners alike.
+
+Then, per preset, the lab's collision-query ratio to plain RRT-Connect (issue #6, their
+6-DOF problem, 10 runs, averages) next to ours on each problem, and on how many of our
+problems the change goes the lab's way: each ratio read as "fewer" (< 0.9), "same"
+(0.9 to 1.1) or "more" (> 1.1) queries, and the lab's way reproduced where the words match.
+
+Problems: the built-in 2-D suite (``ompl_balance.problems``). With ``--mbm N``, also the
+first N problems of each MotionBenchMaker Panda scenario in ``../shared/data/mbm/panda``
+with VAMP's Panda (exact FCL checks, ~0.3-0.5 ms per state: keep N small).
+
+Run: python benchmarks/bench_variants.py [--runs 20] [--time-limit 10] [--mbm 0]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import time
+from pathlib import Path
+
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from ompl_balance.counting import read_work
+from ompl_balance.planners import PRESETS
+from ompl_balance.problems import PROBLEMS
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+
+#: The lab's averages (issue #6): (time s, nodes, collision queries); "plain" is RRT-Connect.
+LAB = {
+    "plain": (39.4, 11660, 579757),
+    "SwapLimitRRTConnect": (3.7, 1866, 45541),
+    "CollisionSwapRRTConnect": (21.6, 10732, 536918),
+    "ExhaustedNodesRRTConnect": (54.2, 12813, 604321),
+    "ExhaustionRRTConnect": (31.3, 9700, 478535),
+    "NeighbourCostRRTConnect": (29.7, 13372, 658073),
+    "GaussianPassageRRTConnect": (29.0, 9419, 481298),
+    "ControlChosenRRTConnect": (23.3, 12862, 282697),
+    "GoalBiasRRTConnect": (29.5, 8309, 457102),
+}
+
+PLANNERS = {"RRTConnect": og.RRTConnect, **PRESETS}
+
+#: A ratio within this band of 1 reads as "same": differences of less than 10 %.
+SAME_BAND = 0.1
+
+
+def effect(ratio: float) -> str:
+    """"fewer", "same" or "more" (collision queries than the reference)."""
+    if ratio < 1 - SAME_BAND:
+        return "fewer"
+    return "more" if ratio > 1 + SAME_BAND else "same"
+
+
+def mbm_problems(count: int) -> dict:
+    """``name -> make_setup`` for the first ``count`` problems of each Panda scenario."""
+    from ompl_balance.mbm import load_mbm
+    from ompl_balance.robots import load_panda_vamp
+    from ompl_balance.validity import CollisionChecker, setup_robot, space_for
+
+    robot = load_panda_vamp(DATA / "robots" / "panda_vamp")
+    problems = {}
+    for path in sorted((DATA / "mbm" / "panda").glob("*.json")):
+        for problem in load_mbm(path, robot.joint_names)[:count]:
+            checker = CollisionChecker(robot, problem.environment)
+
+            def make_setup(problem=problem, checker=checker):
+                ss = og.SimpleSetup(space_for(robot))
+                setup_robot(ss, checker)
+                si = ss.getSpaceInformation()
+                start = si.allocState()
+                for i, value in enumerate(problem.start):
+                    start[i] = float(value)
+                ss.setStartState(start)
+                goals = ob.GoalStates(si)
+                for configuration in problem.goals:
+                    goal = si.allocState()
+                    for i, value in enumerate(configuration):
+                        goal[i] = float(value)
+                    goals.addState(goal)
+                ss.setGoal(goals)
+                return ss
+
+            problems[f"{problem.scenario}#{problem.id}"] = make_setup
+    return problems
+
+
+def run(make_setup, make_planner, time_limit: float) -> dict:
+    ss = make_setup()
+    si = ss.getSpaceInformation()
+    planner = make_planner(si)
+    ss.setPlanner(planner)
+    ss.setup()
+    before = read_work(si)
+    began = time.perf_counter()
+    ss.solve(time_limit)
+    elapsed = time.perf_counter() - began
+    work = read_work(si) - before
+    stats = getattr(planner, "stats", None)
+    if stats is not None:
+        nodes = stats.start_tree_size + stats.goal_tree_size
+    else:
+        data = ob.PlannerData(si)
+        ss.getPlannerData(data)
+        nodes = data.numVertices()
+    return {"solved": ss.haveExactSolutionPath(), "time": elapsed, "queries": work.states_checked, "nodes": nodes}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--runs", type=int, default=20, help="runs per planner and problem (default 20)")
+    parser.add_argument("--time-limit", type=float, default=10.0, help="seconds per run (default 10)")
+    parser.add_argument(
+        "--problems", default=",".join(PROBLEMS), help="2-D problems: comma-separated subset of " + ", ".join(PROBLEMS) + " ('' for none)"
+    )
+    parser.add_argument("--mbm", type=int, default=0, help="also the first N problems of each MBM Panda scenario (default 0)")
+    args = parser.parse_args()
+    ou.RNG.setSeed(1)
+    ou.setLogLevel(ou.LOG_NONE)
+
+    problems = {name: PROBLEMS[name].setup for name in args.problems.split(",") if name}
+    if args.mbm > 0:
+        if (DATA / "mbm" / "panda").is_dir():
+            problems.update(mbm_problems(args.mbm))
+        else:
+            print(f"(no MotionBenchMaker data at {DATA / 'mbm' / 'panda'}: Panda problems skipped)\n")
+
+    print(f"{args.runs} runs per cell, time limit {args.time_limit:g} s; ratios are to stock RRTConnect's medians\n")
+    print("| problem | planner | success | median time (ms) | median collision queries | median nodes "
+          "| time ratio | queries ratio | nodes ratio |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    query_ratios: dict[str, dict[str, float]] = {name: {} for name in PLANNERS}
+    for problem, make_setup in problems.items():
+        results = {name: [] for name in PLANNERS}
+        for _ in range(args.runs):
+            for name, make_planner in PLANNERS.items():
+                results[name].append(run(make_setup, make_planner, args.time_limit))
+        medians = {
+            name: {key: statistics.median(r[key] for r in runs) for key in ("time", "queries", "nodes")}
+            for name, runs in results.items()
+        }
+        stock = medians["RRTConnect"]
+        for name, runs in results.items():
+            m = medians[name]
+            success = sum(r["solved"] for r in runs) / len(runs)
+            ratios = {key: m[key] / stock[key] if stock[key] else math.nan for key in m}
+            query_ratios[name][problem] = ratios["queries"]
+            print(
+                f"| {problem} | {name} | {success:.0%} | {m['time'] * 1e3:.1f} | {m['queries']:.0f} | {m['nodes']:.0f} "
+                f"| {ratios['time']:.2f} | {ratios['queries']:.2f} | {ratios['nodes']:.2f} |",
+                flush=True,
+            )
+
+    print("\nThe lab's findings: collision-query ratio to plain RRT-Connect, theirs and ours\n")
+    print("| preset | lab | " + " | ".join(problems) + " | goes the lab's way |")
+    print("|---|---|" + "---|" * len(problems) + "---|")
+    for name in PRESETS:
+        if name not in LAB:
+            continue
+        lab = LAB[name][2] / LAB["plain"][2]
+        ours = [query_ratios[name][problem] for problem in problems]
+        agree = sum(effect(ratio) == effect(lab) for ratio in ours)
+        cells = " | ".join(f"{ratio:.2f} ({effect(ratio)})" for ratio in ours)
+        print(f"| {name} | {lab:.2f} ({effect(lab)}) | {cells} | {agree} of {len(ours)} |")
+
+
+if __name__ == "__main__":
+    main()

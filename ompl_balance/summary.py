@@ -1,0 +1,157 @@
+"""Summaries of sweep results: medians with bootstrap 95 % intervals, and ratios to a baseline.
+
+Per (problem, planner) cell: success rate, median time and median validity checks over
+all runs that report them (an unsolved run counts with the time and work it spent
+until its limit; a crashed run has no work count). Ratios are medians of the cell over
+medians of the baseline planner's cell on the same problem; their intervals come from
+resampling both cells independently (percentile bootstrap, fixed seed so a table is
+reproducible from its results).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .runner import Record
+
+BOOTSTRAP_SAMPLES = 2000
+Interval = tuple[float, float]
+
+
+def _bootstrap_medians(values: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    return np.median(rng.choice(values, size=(BOOTSTRAP_SAMPLES, len(values))), axis=1)
+
+
+def _interval(samples: np.ndarray) -> Interval:
+    low, high = np.percentile(samples, [2.5, 97.5])
+    return float(low), float(high)
+
+
+@dataclass(frozen=True)
+class Measure:
+    """A median with its 95 % interval, and its ratio to the baseline's median with that ratio's interval."""
+
+    median: float
+    interval: Interval
+    ratio: float
+    ratio_interval: Interval
+
+
+NAN_MEASURE = Measure(math.nan, (math.nan, math.nan), math.nan, (math.nan, math.nan))
+
+
+def measure(values: Sequence[float], baseline: Sequence[float], rng: np.random.Generator, is_baseline: bool = False) -> Measure:
+    """Median of ``values`` and its ratio to the median of ``baseline``, each with a bootstrap 95 % interval.
+
+    The baseline's own ratio is exactly 1 (``is_baseline``); no baseline runs give a NaN ratio.
+    """
+    values, baseline = np.asarray(values, float), np.asarray(baseline, float)
+    if len(values) == 0:
+        return NAN_MEASURE
+    samples = _bootstrap_medians(values, rng)
+    median = float(np.median(values))
+    if is_baseline:
+        return Measure(median, _interval(samples), 1.0, (1.0, 1.0))
+    if len(baseline) == 0 or np.median(baseline) <= 0:
+        return Measure(median, _interval(samples), math.nan, (math.nan, math.nan))
+    base_samples = _bootstrap_medians(baseline, rng)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = samples / base_samples
+    return Measure(median, _interval(samples), median / float(np.median(baseline)), _interval(ratios))
+
+
+@dataclass(frozen=True)
+class CellSummary:
+    """One (problem, planner) cell."""
+
+    problem: str
+    planner: str
+    runs: int
+    crashed: int  # CRASH, or killed at the hard limit
+    success: float  # fraction of runs with an exact solution
+    time: Measure  # s
+    checks: Measure  # validity checks
+    nodes: Measure  # states in the planner's graph (both trees for RRT-Connect)
+
+
+def _values(records: Iterable[Record], name: str) -> list[float]:
+    return [r["properties"][name] for r in records if r["properties"].get(name) is not None]
+
+
+def summarize(records: Iterable[Record], baseline: str, order: Sequence[str] = ()) -> list[CellSummary]:
+    """One :class:`CellSummary` per cell, problems in first-seen order, planners in ``order`` (then first-seen)."""
+    cells: dict[tuple[str, str], list[Record]] = {}
+    for record in records:
+        cells.setdefault((record["problem"], record["planner"]), []).append(record)
+    rank = {label: i for i, label in enumerate(order)}
+    problems = list(dict.fromkeys(problem for problem, _ in cells))
+    keys = sorted(cells, key=lambda k: (problems.index(k[0]), rank.get(k[1], len(rank))))
+    rng = np.random.default_rng(0)
+    summaries = []
+    for problem, planner in keys:
+        runs = cells[problem, planner]
+        base = cells.get((problem, baseline), []) if planner != baseline else []
+        summaries.append(CellSummary(
+            problem=problem,
+            planner=planner,
+            runs=len(runs),
+            crashed=sum(bool(r["error"]) for r in runs),
+            success=sum(r["properties"].get("solved BOOLEAN", 0) for r in runs) / len(runs),
+            time=measure(_values(runs, "time REAL"), _values(base, "time REAL"), rng, planner == baseline),
+            checks=measure(_values(runs, "validity checks INTEGER"), _values(base, "validity checks INTEGER"), rng,
+                           planner == baseline),
+            nodes=measure(_values(runs, "graph states INTEGER"), _values(base, "graph states INTEGER"), rng,
+                          planner == baseline),
+        ))
+    return summaries
+
+
+def _with_interval(value: float, interval: Interval, digits: int) -> str:
+    if math.isnan(value):
+        return "-"
+    return f"{value:.{digits}f} [{interval[0]:.{digits}f}, {interval[1]:.{digits}f}]"
+
+
+def format_markdown(summaries: Sequence[CellSummary], baseline: str) -> str:
+    """A markdown table per problem: success, medians of time, validity checks and nodes, and their
+    ratios to ``baseline``, each with its 95 % interval."""
+    header = (
+        f"| planner | runs | success | median time (ms) | time ratio to {baseline} | median validity checks "
+        f"| checks ratio to {baseline} | median nodes | nodes ratio to {baseline} |\n|---|---|---|---|---|---|---|---|---|"
+    )
+    blocks = []
+    for problem in dict.fromkeys(s.problem for s in summaries):
+        rows = []
+        for s in (s for s in summaries if s.problem == problem):
+            crashed = f" ({s.crashed} crashed)" if s.crashed else ""
+            time_ms = (s.time.median * 1e3, (s.time.interval[0] * 1e3, s.time.interval[1] * 1e3))
+            rows.append(
+                f"| {s.planner} | {s.runs}{crashed} | {s.success:.0%} | {_with_interval(*time_ms, 1)} "
+                f"| {_with_interval(s.time.ratio, s.time.ratio_interval, 2)} | {_with_interval(s.checks.median, s.checks.interval, 0)} "
+                f"| {_with_interval(s.checks.ratio, s.checks.ratio_interval, 2)} "
+                f"| {_with_interval(s.nodes.median, s.nodes.interval, 0)} | {_with_interval(s.nodes.ratio, s.nodes.ratio_interval, 2)} |"
+            )
+        blocks.append(f"### {problem}\n\n{header}\n" + "\n".join(rows))
+    return "\n\n".join(blocks)
+
+
+def format_csv(summaries: Sequence[CellSummary]) -> str:
+    """The summaries as CSV, one row per cell, intervals as ``_low``/``_high`` columns."""
+    columns = ["problem", "planner", "runs", "crashed", "success"]
+    for name in ("time", "checks", "nodes"):
+        columns += [f"{name}_median", f"{name}_low", f"{name}_high", f"{name}_ratio", f"{name}_ratio_low", f"{name}_ratio_high"]
+    out = io.StringIO()
+    writer = csv.writer(out)
+    writer.writerow(columns)
+    for s in summaries:
+        row = [s.problem, s.planner, s.runs, s.crashed, s.success]
+        for m in (s.time, s.checks, s.nodes):
+            row += [m.median, *m.interval, m.ratio, *m.ratio_interval]
+        writer.writerow(row)
+    return out.getvalue()

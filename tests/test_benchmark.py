@@ -1,0 +1,226 @@
+"""Benchmark runner: experiment files, seeded runs in their own processes, OMPL logs and database, summaries."""
+
+from __future__ import annotations
+
+import sqlite3
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ompl_balance.benchmark import bench, compare_experiment, parse_planners
+from ompl_balance.cli import main
+from ompl_balance.experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec, load_experiment, run_seed
+from ompl_balance.ompl_log import write_logs
+from ompl_balance.runner import ResultStore, run_isolated
+from ompl_balance.summary import summarize
+
+SHARED = Path(__file__).resolve().parents[2] / "shared"
+
+GOOD = """\
+name = "tiny"
+runs = 2
+time_limit = 1.0
+seed = 7
+
+[[problems]]
+builtin = "open"
+
+[[planners]]
+name = "RRTConnect"
+params = { range = 0.3 }
+
+[[planners]]
+name = "BalancedRRTConnect"
+label = "Balanced r=0.5"
+params = { max_tree_size_ratio = 0.5 }
+"""
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "experiment.toml"
+    path.write_text(text)
+    return path
+
+
+def deterministic(record: dict) -> tuple:
+    """What a seeded run must repeat exactly (everything but times and memory)."""
+    properties = {k: v for k, v in record["properties"].items() if not k.startswith(("time", "simplification time", "memory"))}
+    return record["problem"], record["planner"], record["run"], record["seed"], record["status"], sorted(properties.items())
+
+
+# -- experiment files ---------------------------------------------------------------------
+
+
+def test_experiment_file_reads_planners_params_and_seeds(tmp_path):
+    experiment = load_experiment(write(tmp_path, GOOD))
+    assert [p.label for p in experiment.planners] == ["RRTConnect", "Balanced r=0.5"]
+    assert experiment.planners[1].params == {"max_tree_size_ratio": "0.5"}
+    tasks = experiment.tasks()
+    assert len(tasks) == 1 * 2 * 2
+    assert len({t.seed for t in tasks}) == 4  # every run its own seed...
+    assert tasks[0].seed == run_seed(7, "open", "RRTConnect", 0)  # ...from the experiment seed and its coordinates
+    assert tasks[0].hard_limit == 2 * 1.0 + experiment.hard_limit_margin
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (('name = "RRTConnect"', 'name = "RRTConnectt"'), ["planners[0].name", "line 10", "unknown planner 'RRTConnectt'", "BalancedRRTConnect"]),
+        (("max_tree_size_ratio = 0.5", "max_tree_ratio = 0.5"), ["planners[1].params.max_tree_ratio", "line 16", "max_tree_size_ratio"]),
+        (("max_tree_size_ratio = 0.5", "max_tree_size_ratio = -1"), ["planners[1].params.max_tree_size_ratio", "line 16"]),
+        (("range = 0.3", "rang = 0.3"), ["planners[0].params.rang", "line 11", "range"]),
+        (("runs = 2", "runs = -3"), ["runs", "line 2", "whole number >= 1"]),
+        (("time_limit = 1.0", "time_limit = 0"), ["time_limit", "line 3", "positive"]),
+        (('builtin = "open"', 'mbm = "nowhere.json"\nrobot = "."'), ["problems[0].mbm", "line 7", "no such file", "nowhere.json"]),
+        (('builtin = "open"', 'builtin = "opne"'), ["problems[0].builtin", "line 7", "narrow_gap"]),
+        (("seed = 7", "sede = 7"), ["sede", "line 4", "unknown key"]),
+        (("runs = 2", "runs = 2 ]"), ["not valid TOML", "line 2"]),
+    ],
+)
+def test_bad_experiment_files_fail_before_any_run_naming_key_and_line(tmp_path, capsys, change, expected):
+    path = write(tmp_path, GOOD.replace(*change))
+    with pytest.raises(ExperimentError) as error:
+        load_experiment(path)
+    for text in expected:
+        assert text in str(error.value)
+    out = tmp_path / "out"
+    assert main(["bench", str(path), "-o", str(out), "--no-progress"]) == 2
+    assert expected[0] in capsys.readouterr().err
+    assert not (out / "results.jsonl").exists()  # nothing ran
+
+
+def test_mbm_problems_expand_ids_and_ranges(tmp_path):
+    scenario = SHARED / "data" / "mbm" / "panda" / "table_pick.json"
+    if not scenario.is_file():
+        pytest.skip(f"shared data not found at {scenario}")
+    text = GOOD.replace('builtin = "open"', f'mbm = "{scenario}"\nrobot = "{SHARED / "data/robots/panda_vamp"}"\nids = [3, "10-12"]')
+    experiment = load_experiment(write(tmp_path, text))
+    assert [p.name for p in experiment.problems] == ["table_pick.003", "table_pick.010", "table_pick.011", "table_pick.012"]
+    with pytest.raises(ExperimentError, match=r"problems\[0\].ids: ids \[101\] not in the file"):
+        load_experiment(write(tmp_path, text.replace('"10-12"', '"10-101"')))
+
+
+def test_planner_list_syntax_of_compare():
+    specs = parse_planners("RRTConnect,BalancedRRTConnect[max_tree_size_ratio=0.5;range=0.1],RRT")
+    assert [s.label for s in specs] == ["RRTConnect", "BalancedRRTConnect[max_tree_size_ratio=0.5;range=0.1]", "RRT"]
+    assert specs[1].params == {"max_tree_size_ratio": "0.5", "range": "0.1"}
+    with pytest.raises(ExperimentError, match=r"planners\[0\].params.nope"):
+        compare_experiment(["open"], parse_planners("RRT[nope=1]"))
+
+
+# -- runs -----------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def tiny_sweep(tmp_path_factory):
+    """GOOD plus stock RRT, on two problems, run with two jobs."""
+    out = tmp_path_factory.mktemp("tiny")
+    experiment = Experiment(
+        name="tiny",
+        problems=(ProblemSpec("open", "builtin", "open"), ProblemSpec("narrow_gap", "builtin", "narrow_gap")),
+        planners=(PlannerSpec("RRTConnect", "RRTConnect", params={"range": "0.3"}),
+                  PlannerSpec("Balanced r=0.5", "BalancedRRTConnect", params={"max_tree_size_ratio": "0.5"}),
+                  PlannerSpec("RRT", "RRT")),
+        runs=2, time_limit=10.0, seed=7)  # a limit no run should reach: limited runs do not repeat
+    records = bench(experiment, out, jobs=2, progress=False)
+    return experiment, out, records
+
+
+def test_sweep_records_every_run_once_with_counters(tiny_sweep):
+    experiment, out, records = tiny_sweep
+    assert sorted((r["problem"], r["planner"], r["run"]) for r in records) == sorted(t.key for t in experiment.tasks())
+    assert all(r["status"] == "EXACT_SOLUTION" and r["properties"]["solved BOOLEAN"] == 1 for r in records)
+    for record in records:
+        properties = record["properties"]
+        assert properties["validity checks INTEGER"] > 0 and properties["motion checks INTEGER"] > 0
+        assert properties["simplified solution length REAL"] <= properties["solution length REAL"] + 1e-9
+    balanced = [r for r in records if r["planner"] == "Balanced r=0.5"]
+    assert all(r["properties"]["iterations INTEGER"] >= 1 and "tree swaps INTEGER" in r["properties"] for r in balanced)
+    assert all(r["params"]["max_tree_size_ratio"] == "0.5" for r in balanced)
+    assert all(r["params"]["range"] == "0.3" for r in records if r["planner"] == "RRTConnect")
+
+
+def test_a_run_re_executed_alone_repeats_its_result(tiny_sweep):
+    experiment, _, records = tiny_sweep
+    by_key = {(r["problem"], r["planner"], r["run"]): r for r in records}
+    for task in [t for t in experiment.tasks() if t.problem.name == "narrow_gap" and t.run == 1]:
+        assert deterministic(run_isolated(task)) == deterministic(by_key[task.key])
+
+
+def test_rerun_skips_finished_runs_and_more_runs_add_only_the_missing(tiny_sweep, tmp_path):
+    experiment, out, records = tiny_sweep
+    lines = (out / "results.jsonl").read_text().splitlines()
+    bench(experiment, out, progress=False)
+    assert (out / "results.jsonl").read_text().splitlines() == lines  # nothing run again
+    with pytest.raises(ExperimentError, match="other time_limit"):
+        bench(Experiment(**{**experiment.__dict__, "time_limit": 3.0}), out, progress=False)
+
+
+def test_ompl_statistics_script_reads_the_logs(tiny_sweep, tmp_path):
+    experiment, out, records = tiny_sweep
+    logs = sorted((out / "logs").glob("*.log"))
+    assert [log.name for log in logs] == ["tiny.narrow_gap.log", "tiny.open.log"]
+    database = tmp_path / "ompl.db"
+    script = Path(sys.executable).with_name("ompl_benchmark_statistics")
+    command = [str(script)] if script.exists() else [sys.executable, "-m", "ompl.ompl_benchmark_statistics"]
+    subprocess.run([*command, *map(str, logs), "-d", str(database)], check=True, capture_output=True)
+    with sqlite3.connect(database) as db:
+        assert db.execute("SELECT COUNT(*) FROM experiments").fetchone()[0] == 2
+        assert db.execute("SELECT COUNT(*) FROM runs").fetchone()[0] == len(records) == 12
+        per_planner = dict(db.execute("SELECT name, COUNT(*) FROM runs JOIN plannerConfigs ON plannerid = plannerConfigs.id GROUP BY name"))
+        assert per_planner == {"RRTConnect": 4, "Balanced r=0.5": 4, "RRT": 4}
+        settings = dict(db.execute("SELECT name, settings FROM plannerConfigs"))
+        assert "max_tree_size_ratio = 0.5" in settings["Balanced r=0.5"] and "seed = run" in settings["Balanced r=0.5"]
+        assert "range = 0.3" in settings["RRTConnect"]
+        columns = {row[1] for row in db.execute("PRAGMA table_info(runs)")}
+        assert {"time", "solved", "status", "solution_length", "solution_segments", "simplified_solution_length",
+                "graph_states", "iterations", "start_tree_size", "goal_tree_size", "tree_swaps", "validity_checks",
+                "motion_checks", "seed"} <= columns
+        checks = db.execute("SELECT SUM(validity_checks) FROM runs").fetchone()[0]
+        assert checks == sum(r["properties"]["validity checks INTEGER"] for r in records)
+    assert (out / "benchmark.db").is_file()
+
+
+def test_summary_ratios_are_to_the_baseline(tiny_sweep):
+    experiment, out, records = tiny_sweep
+    summaries = summarize(records, "RRTConnect", [p.label for p in experiment.planners])
+    assert [(s.problem, s.planner) for s in summaries][:3] == [("open", "RRTConnect"), ("open", "Balanced r=0.5"), ("open", "RRT")]
+    for s in summaries:
+        assert s.time.interval[0] <= s.time.median <= s.time.interval[1]
+        assert s.checks.interval[0] <= s.checks.median <= s.checks.interval[1]
+        if s.planner == "RRTConnect":
+            assert s.checks.ratio == 1.0
+        else:
+            base = next(b for b in summaries if b.problem == s.problem and b.planner == "RRTConnect")
+            assert s.checks.ratio == pytest.approx(s.checks.median / base.checks.median)
+            assert s.checks.ratio_interval[0] <= s.checks.ratio <= s.checks.ratio_interval[1]
+    table = (out / "summary.md").read_text()
+    assert "### open" in table and "### narrow_gap" in table and "| RRT | 2 | 100% |" in table
+    assert (out / "summary.csv").read_text().count("\n") == 1 + 6
+
+
+def test_plot_writes_boxplots_curves_and_trees(tiny_sweep):
+    pytest.importorskip("matplotlib")
+    from ompl_balance.plots import grow_trees, plot_folder
+
+    _, out, _ = tiny_sweep
+    written = plot_folder(out, tree_iterations=40)
+    names = {path.name for path in written}
+    assert {"open.png", "narrow_gap.png", "success_vs_time.png", "trees_narrow_gap.png", "summary.csv"} <= names
+    assert all(path.stat().st_size > 0 for path in written)
+    data, iterations = grow_trees("bug_trap", balance=True, iterations=40)
+    assert iterations == 40  # stopped at the asked iteration
+    tags = {data.getVertex(i).getTag() for i in range(data.numVertices())}
+    assert tags == {1, 2}
+
+
+def test_write_logs_leaves_blank_what_a_crashed_run_lacks(tiny_sweep, tmp_path):
+    experiment, _, records = tiny_sweep
+    crashed = {**records[0], "run": 9, "status": "CRASH", "error": "killed by SIGSEGV",
+               "properties": {"time REAL": 0.5, "status ENUM": 7, "solved BOOLEAN": 0}}
+    log = write_logs(experiment, [records[0], crashed], tmp_path)[0].read_text()
+    run_lines = [line for line in log.splitlines() if line.endswith("; ")]
+    assert len(run_lines) == 2 and run_lines[0].count(";") == run_lines[1].count(";")
+    assert "; ; " in run_lines[1]  # blanks where the crashed run has no value

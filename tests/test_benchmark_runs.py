@@ -1,0 +1,136 @@
+"""Benchmark runner under failure and in parallel: crashes and hangs, a killed sweep resumed, Dask = local pool."""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+
+from ompl_balance.benchmark import bench
+from ompl_balance.experiment import Experiment, PlannerSpec, ProblemSpec
+from test_benchmark import deterministic
+
+REPO = Path(__file__).resolve().parents[1]
+TESTS = Path(__file__).resolve().parent
+
+
+# -- planner factories that fail (called in the run's process) ------------------------------
+
+
+def segfaulting_planner(si: ob.SpaceInformation) -> ob.Planner:
+    ctypes.string_at(0)  # reads address 0: SIGSEGV
+    raise AssertionError("unreachable")
+
+
+class HangingPlanner(ob.Planner):
+    """Ignores its termination condition."""
+
+    def __init__(self, si):
+        super().__init__(si, "Hanging")
+
+    def solve(self, ptc):
+        while True:
+            time.sleep(0.05)
+
+
+def hanging_planner(si: ob.SpaceInformation) -> ob.Planner:
+    return HangingPlanner(si)
+
+
+def test_crash_and_hang_are_recorded_and_the_sweep_goes_on(tmp_path):
+    experiment = Experiment(
+        name="failing",
+        problems=(ProblemSpec("open", "builtin", "open"),),
+        planners=(PlannerSpec("RRTConnect", "RRTConnect"),
+                  PlannerSpec("segfault", factory="test_benchmark_runs:segfaulting_planner"),
+                  PlannerSpec("hang", factory="test_benchmark_runs:hanging_planner")),
+        runs=2, time_limit=0.5, seed=3, hard_limit_margin=1.0)
+    began = time.perf_counter()
+    records = bench(experiment, tmp_path, jobs=2, progress=False)
+    assert time.perf_counter() - began < 30  # the hung runs were killed at 2 x 0.5 + 1 s
+    status = {(r["planner"], r["run"]): r["status"] for r in records}
+    assert status == {("RRTConnect", 0): "EXACT_SOLUTION", ("RRTConnect", 1): "EXACT_SOLUTION",
+                      ("segfault", 0): "CRASH", ("segfault", 1): "CRASH", ("hang", 0): "TIMEOUT", ("hang", 1): "TIMEOUT"}
+    errors = {r["planner"]: r["error"] for r in records}
+    assert "SIGSEGV" in errors["segfault"] and "hard limit" in errors["hang"]
+    assert all(r["properties"]["solved BOOLEAN"] == 0 for r in records if r["planner"] != "RRTConnect")
+    log = (tmp_path / "logs" / "failing.open.log").read_text()
+    assert "\nsegfault\n" in log and "\nhang\n" in log  # failed runs are in the OMPL log too
+    assert "2 crashed" in (tmp_path / "summary.md").read_text()
+
+
+RESUME_TOML = """\
+name = "resume"
+runs = 8
+time_limit = 10.0
+seed = 11
+
+[[problems]]
+builtin = "open"
+
+[[problems]]
+builtin = "narrow_gap"
+
+[[planners]]
+name = "RRTConnect"
+
+[[planners]]
+name = "BalancedRRTConnect"
+"""
+
+
+def _bench_command(experiment: Path, out: Path) -> list[str]:
+    return [sys.executable, "-m", "ompl_balance.cli", "bench", str(experiment), "-o", str(out), "--no-progress"]
+
+
+def test_a_killed_sweep_resumes_without_repeating_or_losing_runs(tmp_path):
+    experiment, out = tmp_path / "resume.toml", tmp_path / "out"
+    experiment.write_text(RESUME_TOML)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), str(TESTS), os.environ.get("PYTHONPATH", "")])}
+    sweep = subprocess.Popen(_bench_command(experiment, out), env=env, start_new_session=True,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    results = out / "results.jsonl"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and (not results.exists() or len(results.read_text().splitlines()) < 5):
+        time.sleep(0.05)
+    os.killpg(sweep.pid, signal.SIGKILL)  # the sweep, its forkserver and the run in flight
+    sweep.wait()
+    before = results.read_text().splitlines()
+    assert 5 <= len(before) < 32, "the sweep should have been killed mid-way"
+
+    finished = subprocess.run(_bench_command(experiment, out), env=env, capture_output=True, text=True, timeout=300)
+    assert finished.returncode == 0, finished.stderr
+    after = [json.loads(line) for line in results.read_text().splitlines() if line.strip()]
+    keys = [(r["problem"], r["planner"], r["run"]) for r in after]
+    assert len(keys) == len(set(keys)) == 2 * 2 * 8  # nothing twice, nothing missing
+    kept = [json.loads(line) for line in before if line.endswith("}")]
+    assert after[:len(kept)] == kept  # what finished before the kill is kept as it was
+    assert "32 runs in" in finished.stdout
+
+
+@pytest.mark.slow
+def test_dask_cluster_gives_the_results_of_the_local_pool(tmp_path, monkeypatch):
+    pytest.importorskip("dask.distributed")
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(REPO), str(TESTS), os.environ.get("PYTHONPATH", "")]))
+    experiment = Experiment(
+        name="same",
+        problems=(ProblemSpec("open", "builtin", "open"), ProblemSpec("narrow_gap", "builtin", "narrow_gap")),
+        planners=(PlannerSpec("RRTConnect", "RRTConnect"), PlannerSpec("BalancedRRTConnect", "BalancedRRTConnect"),
+                  PlannerSpec("alternating", "BalancedRRTConnect", params={"balance_tree_sizes": "0"})),
+        runs=3, time_limit=10.0, seed=5)
+    local = bench(experiment, tmp_path / "local", jobs=2, progress=False)
+    distributed = bench(experiment, tmp_path / "dask", dask="local:2", progress=False)
+    assert len(local) == len(distributed) == 18
+    assert all(r["status"] == "EXACT_SOLUTION" for r in local + distributed)
+    assert sorted(map(deterministic, local)) == sorted(map(deterministic, distributed))
+    logs = sorted(p.name for p in (tmp_path / "dask" / "logs").glob("*.log"))
+    assert logs == sorted(p.name for p in (tmp_path / "local" / "logs").glob("*.log"))

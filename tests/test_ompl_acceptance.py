@@ -1,0 +1,105 @@
+"""OMPL's planner acceptance test (``tests/geometric/2d/2denvs.cpp``) for every planner.
+
+Each planner the package exports (found at import time, see
+``acceptance.package_planners``) and, as the control, stock ``og.RRTConnect`` run
+through the same harness: the simple test, the termination test, the 2-D map test and
+the 2-D circles test at OMPL's thresholds. The default run uses 30 map runs and every
+third circles query (34); ``test_timed_ompl_counts`` (slow) uses OMPL's 100 and 100.
+The timed tests print OMPL's figures and stock's from the same run in their assertion
+messages, with the load average: the time bound is absolute, as in OMPL (set
+``MACHINE_SPEED_FACTOR``, default 3, as OMPL's CMake option, 5 in OMPL's CI), and a
+loaded machine shows in stock's figure as well as ours.
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+from ompl import util as ou
+
+from acceptance import MAP_RUNS, STOCK, package_planners, run_2d_circles_test, run_2d_map_test, simple_test, termination_test
+from ompl_envs import RESOURCES, load_circles, load_environment, load_queries
+
+ou.setLogLevel(ou.LOG_ERROR)  # as TestPlanner's constructor
+
+pytestmark = pytest.mark.skipif(
+    not (RESOURCES / "env1.txt").is_file(),
+    reason=f"OMPL's test resources are absent: expected env1.txt and circle_*.txt in {RESOURCES}",
+)
+
+PLANNERS = [STOCK, *package_planners()]
+# The default run: fewer runs than OMPL's so that it stays within about a minute for a
+# dozen planners; test_timed_ompl_counts (slow) runs OMPL's 100 + 100.
+REDUCED_MAP_RUNS = 30
+REDUCED_QUERY_STRIDE = 3
+
+
+@pytest.fixture(scope="module")
+def env():
+    return load_environment(RESOURCES / "env1.txt")
+
+
+@pytest.fixture(scope="module")
+def circles():
+    return load_circles(RESOURCES / "circle_obstacles.txt"), load_queries(RESOURCES / "circle_queries.txt")
+
+
+def measure(env, circles, queries, map_runs: int):
+    """Every planner's :class:`Outcome` of both timed tests by (test, label), and the load.
+
+    Planners are interleaved run by run, so a loaded phase of the machine hits all alike.
+    """
+    load_before = os.getloadavg()[0]
+    measured = run_2d_map_test(PLANNERS, env, map_runs) + run_2d_circles_test(PLANNERS, circles, queries)
+    load = f"load average {load_before:.2f} before, {os.getloadavg()[0]:.2f} after measuring"
+    return {(outcome.test, outcome.planner): outcome for outcome in measured}, load
+
+
+@pytest.fixture(scope="module")
+def reduced_outcomes(env, circles):
+    """The default run: 30 map runs and every third circles query (34)."""
+    obstacles, queries = circles
+    return measure(env, obstacles, queries[::REDUCED_QUERY_STRIDE], REDUCED_MAP_RUNS)
+
+
+@pytest.fixture(scope="module")
+def full_outcomes(env, circles):
+    """OMPL's counts: 100 map runs and all 100 circles queries."""
+    obstacles, queries = circles
+    return measure(env, obstacles, queries, MAP_RUNS)
+
+
+def assert_accepted(outcomes, test: str, entry) -> None:
+    """OMPL's three checks (success, average time, average length); no path fails the re-check."""
+    measured, load = outcomes
+    outcome, stock = measured[test, entry.label], measured[test, STOCK.label]
+    report = f"{outcome.summary()}; stock in the same run: {stock.summary()}; {load}"
+    assert outcome.faulty_paths == [], f"paths that fail the independent re-check: {outcome.faulty_paths[:5]}"
+    assert outcome.unmet() == [], f"{outcome.unmet()}: {report}"
+
+
+@pytest.mark.parametrize("entry", PLANNERS, ids=lambda entry: entry.label)
+def test_simple(entry, env):
+    assert simple_test(entry, env) == []
+
+
+@pytest.mark.parametrize("entry", PLANNERS, ids=lambda entry: entry.label)
+def test_termination(entry, env):
+    """Nothing but the query states is valid: ``solve(0.1)`` returns promptly, unsolved."""
+    elapsed, solved = termination_test(entry, env, limit=0.1)
+    assert not solved
+    assert elapsed < 0.5, f"solve(0.1) took {elapsed:.3f} s with nothing valid to sample"
+
+
+@pytest.mark.parametrize("test", ["2D map", "2D circles"])
+@pytest.mark.parametrize("entry", PLANNERS, ids=lambda entry: entry.label)
+def test_timed(entry, test, reduced_outcomes):
+    assert_accepted(reduced_outcomes, test, entry)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("test", ["2D map", "2D circles"])
+@pytest.mark.parametrize("entry", PLANNERS, ids=lambda entry: entry.label)
+def test_timed_ompl_counts(entry, test, full_outcomes):
+    assert_accepted(full_outcomes, test, entry)

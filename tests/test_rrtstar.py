@@ -1,0 +1,232 @@
+"""BallRadiusRRTstar: valid paths, monotone cost, the gamma claim, drop-in behaviour, bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import tools as ot
+from ompl import util as ou
+
+from ompl_balance.gamma import ball_radius_constant
+from ompl_balance.occupancy import rooms_problem
+from ompl_balance.planners import BallRadiusRRTstar
+from ompl_balance.problems import get_problem
+from pathcheck import assert_valid_solution
+
+ou.setLogLevel(ou.LOG_WARN)
+
+
+def _planner(ss: og.SimpleSetup, **params: str) -> BallRadiusRRTstar:
+    planner = BallRadiusRRTstar(ss.getSpaceInformation())
+    assert planner.params().setParams(params)
+    ss.setPlanner(planner)
+    return planner
+
+
+def _goal_test(si, goal_values):
+    def reaches(state) -> bool:
+        return math.dist([state[i] for i in range(len(goal_values))], goal_values) < 1e-9
+
+    return reaches
+
+
+def test_rooms_path_is_valid_and_its_cost_is_the_reported_best():
+    problem = rooms_problem()
+    ss = problem.setup()
+    planner = _planner(ss, max_connection_distance="4", max_iterations="800", seed="1", ball_radius_constant="auto")
+    assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+    start = ss.getSpaceInformation().allocState()
+    problem.write_state(start, problem.start)
+    path = assert_valid_solution(ss, problem.is_valid, [start], _goal_test(None, problem.goal))
+    assert path.length() == pytest.approx(planner.stats.best_cost)
+    assert planner.stats.tree_size <= planner.stats.iterations + 1
+    assert planner.stats.rewires > 0
+
+
+def test_se2_rooms_path_is_valid():
+    problem = rooms_problem(se2=True)
+    ss = problem.setup()
+    # SE(2) runs on OMPL's sampler (the seed parameter does not apply): stop at the first path
+    planner = _planner(ss, max_connection_distance="6", max_iterations="0", goal_bias="0.2", continue_after_goal_reached="0")
+    assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
+    si = ss.getSpaceInformation()
+    start, goal = si.allocState(), si.allocState()
+    problem.write_state(start, problem.start)
+    problem.write_state(goal, problem.goal)
+    assert_valid_solution(ss, problem.is_valid, [start], lambda state: si.distance(state, goal) < 1e-9)
+    assert planner.stats.best_cost == pytest.approx(ss.getSolutionPath().length())
+
+
+@pytest.mark.parametrize("name", ["maze", "bug_trap"])
+def test_box_world_paths_are_valid(name):
+    problem = get_problem(name)
+    ss = problem.setup()
+    _planner(ss, max_iterations="4000", seed="2")
+    assert ss.solve(30.0)
+    si = ss.getSpaceInformation()
+    start = si.allocState()
+    start[0], start[1] = problem.start
+    assert_valid_solution(ss, problem.world(), [start], _goal_test(si, problem.goal))
+
+
+def test_best_cost_never_increases_and_matches_the_iterations():
+    ss = rooms_problem().setup()
+    planner = _planner(ss, max_connection_distance="4", max_iterations="600", seed="5", ball_radius_constant="3000")
+    ss.solve(30.0)
+    costs = planner.stats.best_costs
+    assert len(costs) == planner.stats.iterations == 600
+    first = planner.stats.first_solution_iteration
+    assert first is not None and np.all(np.isinf(costs[: first - 1])) and np.isfinite(costs[first - 1])
+    assert np.all(np.diff(costs[first - 1 :]) <= 0)
+    assert costs[-1] == planner.stats.best_cost
+    assert costs[-1] < costs[first - 1]  # rewiring improved the first path
+
+
+def test_estimated_gamma_beats_the_default_of_100_at_equal_iterations():
+    """The claim of issue 4: with gamma = 100 the 40 m map's ball is nearly empty and the cost stalls."""
+    problem = rooms_problem()
+    final = {}
+    for gamma in ("100", "auto"):
+        costs = []
+        for seed in range(1, 11):
+            ss = problem.setup()
+            planner = _planner(ss, ball_radius_constant=gamma, max_connection_distance="4", max_iterations="1000", seed=str(seed))
+            ss.solve(60.0)
+            assert planner.stats.iterations == 1000
+            costs.append(planner.stats.best_cost)
+        final[gamma] = costs
+    # the estimate is close to gamma* of the exact free area
+    assert planner.getBallRadiusConstantInUse() == pytest.approx(ball_radius_constant(2, problem.grid.free_area), rel=0.05)
+    assert np.median(final["auto"]) < np.median(final["100"]), final
+
+
+def test_cost_threshold_stops_at_the_first_solution():
+    ss = rooms_problem().setup()
+    objective = ob.PathLengthOptimizationObjective(ss.getSpaceInformation())
+    objective.setCostThreshold(ob.Cost(1e6))
+    ss.setOptimizationObjective(objective)
+    planner = _planner(ss, max_connection_distance="4", max_iterations="3000", seed="3")
+    assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.stats.iterations == planner.stats.first_solution_iteration < 3000
+
+
+def test_not_continuing_after_the_goal_stops_at_the_first_solution():
+    ss = rooms_problem().setup()
+    planner = _planner(ss, max_connection_distance="4", max_iterations="3000", seed="3", continue_after_goal_reached="0")
+    assert ss.solve(30.0)
+    assert planner.stats.iterations == planner.stats.first_solution_iteration
+
+
+def test_limits_on_iterations_and_nodes():
+    ss = rooms_problem().setup()
+    planner = _planner(ss, max_connection_distance="4", max_iterations="0", max_nodes="150", seed="3")
+    ss.solve(30.0)
+    assert planner.stats.tree_size == 150
+    planner.clear()
+    planner.setMaxNodes(0)
+    planner.setMaxIterations(50)
+    ss.getProblemDefinition().clearSolutionPaths()
+    assert ss.solve(30.0) == ob.PlannerStatus.TIMEOUT
+    assert planner.stats.iterations == 50
+
+
+def test_same_seed_same_run():
+    runs = []
+    for _ in range(2):
+        ss = rooms_problem().setup()
+        planner = _planner(ss, max_connection_distance="4", max_iterations="300", seed="11", ball_radius_constant="auto")
+        ss.solve(30.0)
+        runs.append((planner.getBallRadiusConstantInUse(), planner.stats.best_costs, planner.stats.states_checked))
+    assert runs[0][0] == runs[1][0] and runs[0][2] == runs[1][2]
+    np.testing.assert_array_equal(runs[0][1], runs[1][1])
+
+
+def test_planner_data_is_the_tree():
+    ss = rooms_problem().setup()
+    planner = _planner(ss, max_connection_distance="4", max_iterations="300", seed="4")
+    ss.solve(30.0)
+    data = planner.plannerData()
+    assert data.numVertices() == planner.stats.tree_size
+    assert data.numEdges() == planner.stats.tree_size - 1
+    assert data.numStartVertices() == 1
+    assert data.numGoalVertices() >= 1
+
+
+def test_drops_into_a_benchmark_next_to_stock_rrtstar():
+    ss = rooms_problem().setup()
+    benchmark = ot.Benchmark(ss, "rrtstar drop-in")
+    ours = BallRadiusRRTstar(ss.getSpaceInformation())
+    ours.params().setParams({"max_connection_distance": "4", "max_iterations": "500"})
+    stock = og.RRTstar(ss.getSpaceInformation())
+    stock.setRange(4.0)
+    benchmark.addPlanner(ours)
+    benchmark.addPlanner(stock)
+    benchmark.benchmark(ot.Request(2.0, 1024.0, 2, 0.05, False, False, False))
+    planners = {p.name: p for p in benchmark.getRecordedExperimentData().planners}
+    for name in ("geometric_BallRadiusRRTstar", "geometric_RRTstar"):
+        runs = planners[name].runs
+        assert len(runs) == 2 and all(run.to_dict()["solved BOOLEAN"] == "1" for run in runs)
+
+
+def test_parameters_and_camel_case_accessors():
+    planner = BallRadiusRRTstar(rooms_problem().setup().getSpaceInformation())
+    params = planner.params()
+    assert set(params.getParamNames()) == {
+        "max_connection_distance",
+        "ball_radius_constant",
+        "goal_bias",
+        "continue_after_goal_reached",
+        "max_iterations",
+        "max_nodes",
+        "seed",
+    }
+    assert params.getParam("ball_radius_constant") == "100.0" and params.getParam("goal_bias") == "0.05"
+    assert params.setParam("ball_radius_constant", "auto") and planner.getBallRadiusConstant() == "auto"
+    assert planner.getBallRadiusConstantInUse() is None
+    planner.setBallRadiusConstant(250.0)
+    assert params.getParam("ball_radius_constant") == "250.0" and planner.getBallRadiusConstantInUse() == 250.0
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("ball_radius_constant", "-1"),
+        ("ball_radius_constant", "0"),
+        ("ball_radius_constant", "lots"),
+        ("ball_radius_constant", "inf"),
+        ("goal_bias", "1.5"),
+        ("goal_bias", "-0.1"),
+        ("max_connection_distance", "-2"),
+        ("max_iterations", "-3"),
+        ("max_iterations", "2.5"),
+        ("max_nodes", "many"),
+        ("continue_after_goal_reached", "maybe"),
+        ("rewire_factor", "1.1"),
+    ],
+)
+def test_bad_parameters_are_rejected_and_leave_the_planner_unchanged(name, value):
+    planner = BallRadiusRRTstar(rooms_problem().setup().getSpaceInformation())
+    before = planner.params().getParams()
+    assert planner.params().setParam(name, value) is False
+    assert planner.params().getParams() == before
+
+
+def test_other_objectives_are_refused_with_a_clear_error():
+    ss = rooms_problem().setup()
+    si = ss.getSpaceInformation()
+    ss.setOptimizationObjective(ob.StateCostIntegralObjective(si, True))
+    _planner(ss, max_iterations="10")
+    with pytest.raises(ValueError, match="path length"):
+        ss.solve(1.0)  # through SimpleSetup's C++ solve into the Python planner and back
+
+
+def test_bad_time_limit_is_rejected():
+    ss = rooms_problem().setup()
+    planner = _planner(ss)
+    ss.setup()
+    with pytest.raises(ValueError, match="time limit"):
+        planner.solve(-1.0)

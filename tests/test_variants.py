@@ -1,0 +1,414 @@
+"""The classroom RRT-Connect variants: each policy on a hand-made situation, the presets, parameters."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import tools as ot
+from ompl import util as ou
+
+import ompl_balance.planners as planners
+from ompl_balance.planners import (
+    ALTERNATE,
+    BALANCE,
+    COLLISION,
+    PRESETS,
+    SAMPLE_POLICIES,
+    STEPS,
+    SWAP_POLICIES,
+    BalancedRRTConnect,
+    GaussianPassageRRTConnect,
+    Grow,
+    balance_choice,
+    exhaustion_scale,
+    nearest_by_exhaustion,
+    nearest_not_exhausted,
+    node_quality,
+    tree_chooser,
+)
+from ompl_balance.problems import get_problem
+from ompl_balance.samplers import GaussianValidStateSampler
+from pathcheck import assert_valid_solution
+
+ou.setLogLevel(ou.LOG_WARN)
+
+
+# -- pure rules ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("grew_start", [True, False])
+def test_alternate_always_swaps(grew_start):
+    choose = tree_chooser("alternate")
+    for sizes, steps, collided in (((1, 100), 0, False), ((50, 50), 9, True)):
+        assert choose(grew_start, *sizes, steps, collided) == (not grew_start, ALTERNATE)
+
+
+def test_balance_nodes_is_the_balancing_rule_else_alternation():
+    choose = tree_chooser("balance_nodes", max_tree_size_ratio=1.0)
+    for start_size, goal_size in ((10, 10), (10, 19), (10, 20), (20, 10), (1, 100)):
+        for grew_start in (True, False):
+            rule = balance_choice(start_size, goal_size, True, 1.0)
+            expected = (not grew_start, ALTERNATE) if rule is None else (rule, BALANCE)
+            assert choose(grew_start, start_size, goal_size, 0, False) == expected
+
+
+def test_balance_steps_swaps_exactly_at_swap_steps():
+    choose = tree_chooser("balance_steps", swap_steps=4)
+    for grew_start in (True, False):
+        assert [choose(grew_start, 5, 500, steps, True)[0] for steps in range(7)] == [grew_start] * 4 + [not grew_start] * 3
+    assert choose(True, 1, 1, 4, False)[1] == STEPS
+
+
+def test_on_collision_swaps_only_after_a_collision():
+    choose = tree_chooser("on_collision")
+    assert choose(True, 5, 500, 99, False) == (True, COLLISION)
+    assert choose(False, 5, 500, 99, False) == (False, COLLISION)
+    assert choose(True, 5, 5, 0, True) == (False, COLLISION)
+
+
+def test_unknown_swap_policy_names_the_accepted_ones():
+    with pytest.raises(ValueError, match="alternate, balance_nodes, balance_steps, on_collision"):
+        tree_chooser("sometimes")
+
+
+def test_exhaustion_scale_is_the_lab_formula():
+    target = 5
+    failures = np.arange(0, 16)
+    expected = [0.9 + 0.1 * abs(target - f) / target for f in failures]
+    assert exhaustion_scale(failures, target) == pytest.approx(expected)
+    assert exhaustion_scale(0, target) == pytest.approx(1.0)
+    assert exhaustion_scale(target, target) == pytest.approx(0.9)
+    assert exhaustion_scale(2 * target, target) == pytest.approx(1.0)
+
+
+def test_exhaustion_nearest_minimises_the_scaled_distance():
+    distances = np.array([1.00, 1.05, 1.20, 0.99])
+    failures = np.array([0, 5, 5, 30])
+    # scaled: 1.0, 0.945, 1.08, 0.99 * 1.5 = 1.485 -> node 1 although node 3 is nearest
+    assert nearest_by_exhaustion(distances, failures, 5) == 1
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        distances, failures = rng.uniform(0, 1, 40), rng.integers(0, 20, 40)
+        scaled = [d * (0.9 + 0.1 * abs(7 - f) / 7) for d, f in zip(distances, failures)]
+        assert nearest_by_exhaustion(distances, failures, 7) == int(np.argmin(scaled))
+
+
+def test_exhausted_nodes_are_skipped_unless_all_are():
+    distances = np.array([0.1, 0.2, 0.3])
+    assert nearest_not_exhausted(distances, np.array([15, 14, 0]), 15) == 1
+    assert nearest_not_exhausted(distances, np.array([15, 15, 2]), 15) == 2
+    assert nearest_not_exhausted(distances, np.array([20, 15, 16]), 15) == 0  # all exhausted: plain nearest
+
+
+def test_node_quality_is_the_hrrt_formula():
+    assert node_quality(2.0, 2.0, 4.0, 0.0) == 1.0  # an optimal node
+    assert node_quality(4.0, 2.0, 4.0, 0.0) == 0.0  # the worst node
+    assert node_quality(3.0, 2.0, 4.0, 0.0) == pytest.approx(0.5)
+    assert node_quality(4.0, 2.0, 4.0, 0.2) == pytest.approx(0.2)  # floored at min_quality
+    assert node_quality(2.0, 2.0, 2.0, 0.0) == 1.0  # every node optimal
+
+
+# -- the policies inside a run: recorded with wrappers around the planner's own steps ------
+
+
+def traced_run(monkeypatch, problem: str, **params):
+    """Solve ``problem`` recording each tree choice and each extension step, in order.
+
+    Events: ``("choose", grew_start, steps, collided, grow_start)`` and
+    ``("grow", from_start, target, nearest_given, outcome)``.
+    """
+    events = []
+    real_chooser = planners.tree_chooser
+
+    def recording_chooser(*args, **kwargs):
+        choose = real_chooser(*args, **kwargs)
+
+        def recorded(grew_start, start_size, goal_size, steps, collided):
+            grow_start, cause = choose(grew_start, start_size, goal_size, steps, collided)
+            events.append(("choose", grew_start, steps, collided, grow_start))
+            return grow_start, cause
+
+        return recorded
+
+    monkeypatch.setattr(planners, "tree_chooser", recording_chooser)
+    ss = get_problem(problem).setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    assert planner.params().setParams({key: str(value) for key, value in params.items()})
+    real_grow = planner._grow
+
+    def recording_grow(tree, from_start, target, nearest=None):
+        outcome = real_grow(tree, from_start, target, nearest)
+        events.append(("grow", from_start, np.array(target, dtype=float), nearest is not None, outcome[0]))
+        return outcome
+
+    planner._grow = recording_grow
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    return ss, planner, events
+
+
+def replay_swaps(events):
+    """Per iteration: (grew_start, grow_start, connect steps since the last swap, last connect trapped)."""
+    decisions, steps, collided, current = [], 0, False, None
+    for event in events:
+        if event[0] == "choose":
+            _, _, _, _, grow_start = event
+            decisions.append((current, grow_start, steps, collided))
+            if grow_start != current:
+                steps, collided = 0, False
+            current = grow_start
+        elif event[1] != current:  # a connect step: the other tree grows
+            steps += 1
+            collided = event[4] is Grow.TRAPPED
+    return decisions[1:]  # the first iteration has no previous tree
+
+
+def test_balance_steps_swaps_after_exactly_swap_steps_connect_steps(monkeypatch):
+    ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="balance_steps", swap_steps=3)
+    decisions = replay_swaps(events)
+    assert len(decisions) > 20
+    for grew_start, grow_start, steps, _ in decisions:
+        assert (grow_start != grew_start) == (steps >= 3)
+    # what the planner passed to the rule is what the trace counts
+    passed = [(e[2], e[3]) for e in events if e[0] == "choose"][1:]
+    assert [steps for steps, _ in passed] == [steps for _, _, steps, _ in decisions]
+    assert planner.stats.swaps_steps == planner.stats.tree_swaps == sum(g != s for g, s, _, _ in decisions)
+
+
+def test_on_collision_never_swaps_after_a_collision_free_connect(monkeypatch):
+    ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="on_collision")
+    decisions = replay_swaps(events)
+    swaps = [(grew, grow, collided) for grew, grow, _, collided in decisions]
+    assert any(grew != grow for grew, grow, _ in swaps)
+    assert any(grew == grow for grew, grow, _ in swaps)  # trapped extensions keep the tree
+    assert all((grew != grow) == collided for grew, grow, collided in swaps)
+    assert planner.stats.swaps_collision == planner.stats.tree_swaps > 0
+
+
+def extension_targets(events):
+    """(grown tree is the start tree, target) of each iteration's extension step."""
+    targets, current = [], None
+    for event in events:
+        if event[0] == "choose":
+            current, first = event[4], True
+        elif event[1] == current and first:
+            targets.append((current, event[2]))
+            first = False
+    return targets
+
+
+def test_goal_ball_never_targets_farther_from_the_goal_than_the_start(monkeypatch):
+    problem = get_problem("bug_trap")
+    ss, planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_ball")
+    start, goal = np.array(problem.start), np.array(problem.goal)
+    radius = np.linalg.norm(goal - start)
+    targets = extension_targets(events)
+    assert sum(grow_start for grow_start, _ in targets) > 10
+    for grow_start, target in targets:
+        centre = goal if grow_start else start
+        assert np.linalg.norm(target - centre) <= radius + 1e-12
+    assert planner.stats.sampler_rejections > 0  # the ball does not cover the square
+
+
+def test_goal_bias_targets_the_other_root_at_the_given_rate(monkeypatch):
+    problem = get_problem("bug_trap")
+    ss, planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_bias", goal_bias=0.5, seed=5)
+    roots = {True: np.array(problem.goal), False: np.array(problem.start)}
+    targets = extension_targets(events)
+    at_root = [np.array_equal(target, roots[grow_start]) for grow_start, target in targets]
+    n = len(at_root)
+    assert n > 50
+    assert abs(sum(at_root) / n - 0.5) < 4 * math.sqrt(0.25 / n)  # within 4 standard deviations
+
+
+def test_exhausted_policy_never_extends_an_exhausted_node(monkeypatch):
+    ss = get_problem("bug_trap").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setNearestPolicy("exhausted")
+    planner.setExhaustedAfter(2)
+    picks = []
+    real = planner._nearest_by_failures
+
+    def checked(tree, target):
+        node, distance = real(tree, target)
+        counts = planner._failures[tree].counts(len(tree))
+        picks.append(counts[node] < 2 or bool(np.all(counts >= 2)))
+        return node, distance
+
+    planner._nearest_by_failures = checked
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert len(picks) > 10 and all(picks)
+
+
+def test_failed_extensions_are_counted_per_node(monkeypatch):
+    ss, planner, events = traced_run(monkeypatch, "bug_trap", nearest_policy="exhaustion")
+    trapped = sum(1 for e in events if e[0] == "grow" and e[4] is Grow.TRAPPED)
+    recorded = sum(int(failures.counts(len(tree)).sum()) for tree, failures in planner._failures.items())
+    assert trapped > 0 and recorded == trapped
+
+
+def test_euclidean_policy_counts_no_failures(monkeypatch):
+    ss, planner, events = traced_run(monkeypatch, "bug_trap")
+    assert all(int(f.counts(len(t)).sum()) == 0 for t, f in planner._failures.items())
+
+
+def test_neighbour_quality_rejects_samples_unless_min_quality_is_one():
+    rejections = []
+    for min_quality in (0.0, 1.0):
+        ss = get_problem("bug_trap").setup()
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        planner.setSamplePolicy("neighbour_quality")
+        planner.setMinQuality(min_quality)
+        ss.setPlanner(planner)
+        assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+        rejections.append(planner.stats.sampler_rejections)
+    assert rejections[0] > 0 and rejections[1] == 0
+
+
+def test_valid_sampler_policy_draws_from_the_space_informations_sampler():
+    problem = get_problem("narrow_gap")
+    ss = problem.setup()
+    # (an allocator that keeps its samplers, e.g. in a closure, makes a reference cycle
+    # through the space information: pass the class)
+    ss.getSpaceInformation().setValidStateSamplerAllocator(GaussianValidStateSampler)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setSamplePolicy("valid_sampler")
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    stats = planner.stats
+    assert isinstance(planner._valid_sampler, GaussianValidStateSampler)
+    assert stats.sampler_checks == planner._valid_sampler.validity_checks > 0
+    assert stats.states_checked > stats.sampler_checks
+    start = ss.getSpaceInformation().allocState()
+    start[0], start[1] = problem.start
+    assert_valid_solution(ss, problem.world(), [start], ss.getGoal().isSatisfied)
+
+
+def test_swaps_by_cause_add_up():
+    ss = get_problem("bug_trap").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    assert ss.solve(10.0)
+    stats = planner.stats
+    assert stats.swaps_balance > 0 and stats.swaps_alternate > 0
+    assert stats.swaps_alternate + stats.swaps_balance == stats.tree_swaps
+    assert stats.swaps_steps == stats.swaps_collision == stats.sampler_rejections == stats.sampler_checks == 0
+
+
+# -- presets ----------------------------------------------------------------------------------
+
+LAB_PRESETS = [name for name in PRESETS if name != "BalancedRRTConnect"]
+
+
+def test_presets_are_named_and_differ_only_in_parameters():
+    si = get_problem("open").setup().getSpaceInformation()
+    assert len(LAB_PRESETS) == 8
+    settings = set()
+    for name, planner_class in PRESETS.items():
+        planner = planner_class(si)
+        assert planner.getName() == name
+        assert issubclass(planner_class, BalancedRRTConnect)
+        settings.add(tuple(sorted(planner.params().getParams().items())))
+    # GaussianPassage differs from a plain valid_sampler run by its sampler, not its parameters
+    assert len(settings) == len(PRESETS)
+
+
+@pytest.mark.parametrize("problem_name", ["narrow_gap", "bug_trap"])
+@pytest.mark.parametrize("preset", LAB_PRESETS)
+def test_every_preset_solves_with_a_valid_path(preset, problem_name):
+    problem = get_problem(problem_name)
+    ss = problem.setup()
+    planner = PRESETS[preset](ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    assert ss.solve(20.0) == ob.PlannerStatus.EXACT_SOLUTION
+    start = ss.getSpaceInformation().allocState()
+    start[0], start[1] = problem.start
+    assert_valid_solution(ss, problem.world(), [start], ss.getGoal().isSatisfied)
+
+
+def test_every_preset_runs_in_ompl_benchmark(tmp_path):
+    ss = get_problem("narrow_gap").setup()
+    si = ss.getSpaceInformation()
+    benchmark = ot.Benchmark(ss, "presets")
+    benchmark.addPlanner(og.RRTConnect(si))
+    for planner_class in PRESETS.values():
+        benchmark.addPlanner(planner_class(si))
+    benchmark.benchmark(ot.Request(5.0, 1024.0, 2, 0.05, False, False, False))
+    log = tmp_path / "presets.log"
+    assert benchmark.saveResultsToFile(str(log))
+    planners_run = {p.name: p for p in benchmark.getRecordedExperimentData().planners}
+    for name in PRESETS:
+        runs = planners_run[f"geometric_{name}"].runs
+        assert len(runs) == 2
+        assert all(run.to_dict()["solved BOOLEAN"] == "1" for run in runs), name
+
+
+def test_gaussian_passage_preset_uses_the_passage_sampler():
+    ss = get_problem("narrow_gap").setup()
+    planner = GaussianPassageRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    assert ss.solve(10.0)
+    assert type(planner._valid_sampler).__name__ == "PassageSampler"
+    assert planner.stats.sampler_checks > 0
+
+
+# -- parameters --------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "accepted"),
+    [
+        ("swap_policy", "sometimes", ", ".join(SWAP_POLICIES)),
+        ("nearest_policy", "closest", "euclidean, exhausted, exhaustion"),
+        ("sample_policy", "gaussian", ", ".join(SAMPLE_POLICIES)),
+        ("swap_steps", "0", "swap_steps must be an integer >= 1"),
+        ("exhausted_after", "-2", "exhausted_after must be an integer >= 1"),
+        ("exhaustion_target", "2.5", "1:1:100"),
+        ("goal_bias", "1.5", "goal_bias must be a number in [0, 1]"),
+        ("min_quality", "-0.1", "min_quality must be a number in [0, 1]"),
+    ],
+)
+def test_bad_policy_values_are_refused_with_what_is_accepted(name, value, accepted, capfd):
+    planner = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation())
+    before = planner.params().getParams()
+    assert planner.params().setParam(name, value) is False
+    assert planner.params().getParams() == before
+    error = capfd.readouterr().err
+    assert name in error and accepted in error
+
+
+def test_choice_parameters_suggest_their_choices():
+    params = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation()).params()
+    assert params.getRangeSuggestion("swap_policy") == ",".join(SWAP_POLICIES)
+    assert params.getRangeSuggestion("sample_policy") == ",".join(SAMPLE_POLICIES)
+    assert params.getRangeSuggestion("nearest_policy") == "euclidean,exhausted,exhaustion"
+
+
+def test_balance_tree_sizes_is_swap_policy_balance_nodes():
+    planner = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation())
+    params = planner.params()
+    assert params.getParam("swap_policy") == "balance_nodes" and params.getParam("balance_tree_sizes") == "1"
+    assert params.setParam("balance_tree_sizes", "0")
+    assert params.getParam("swap_policy") == "alternate"
+    assert params.setParam("swap_policy", "balance_nodes")
+    assert params.getParam("balance_tree_sizes") == "1"
+    assert params.setParam("swap_policy", "on_collision")
+    assert params.getParam("balance_tree_sizes") == "0"
+    assert params.setParam("balance_tree_sizes", "0")  # already not balancing: the policy stays
+    assert params.getParam("swap_policy") == "on_collision"
+    assert params.setParam("balance_tree_sizes", "1")
+    assert params.getParam("swap_policy") == "balance_nodes"
+
+
+def test_valid_sampler_with_a_fixed_seed_is_refused_at_setup():
+    ss = get_problem("open").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    assert planner.params().setParams({"sample_policy": "valid_sampler", "seed": "3"})
+    ss.setPlanner(planner)
+    with pytest.raises(ValueError, match="valid_sampler.*seed"):
+        ss.setup()
