@@ -17,19 +17,17 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 from pathlib import Path
 
 import numpy as np
-from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect
-from ompl_balance.counting import read_work
+from ompl_balance.counting import measured_solve
 from ompl_balance.mbm import load_mbm
 from ompl_balance.robots import load_panda_vamp
-from ompl_balance.validity import CollisionChecker, setup_robot, space_for
+from ompl_balance.validity import CollisionChecker
 
 SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small")
 PLANNERS = {"RRTConnect": og.RRTConnect, "BalancedRRTConnect": BalancedRRTConnect}
@@ -37,37 +35,17 @@ PLANNERS = {"RRTConnect": og.RRTConnect, "BalancedRRTConnect": BalancedRRTConnec
 
 def solve(robot, problem, make_planner, time_limit: float) -> dict:
     """One planning run; returns success, seconds, work counts and whether the path re-checks valid."""
-    ss = og.SimpleSetup(space_for(robot))
-    checker = CollisionChecker(robot, problem.environment)
-    setup_robot(ss, checker)
-    si = ss.getSpaceInformation()
-    start = si.allocState()
-    for i, value in enumerate(problem.start):
-        start[i] = float(value)
-    ss.setStartState(start)
-    goals = ob.GoalStates(si)
-    for configuration in problem.goals:
-        goal = si.allocState()
-        for i, value in enumerate(configuration):
-            goal[i] = float(value)
-        goals.addState(goal)
-    ss.setGoal(goals)
-    ss.setPlanner(make_planner(si))
-    ss.setup()
-    before = read_work(si)
-    began = time.perf_counter()
-    ss.solve(time_limit)
-    elapsed = time.perf_counter() - began
-    work = read_work(si) - before
-    solved = bool(ss.haveExactSolutionPath())
+    ss = problem.simple_setup(robot)
+    ss.setPlanner(make_planner(ss.getSpaceInformation()))
+    run = measured_solve(ss, time_limit)
     path_valid = None
-    if solved:
+    if run.solved:
         path = ss.getSolutionPath()
         path.interpolate()  # states at the space's validity-checking resolution
         states = np.array([path.getState(i)[0:robot.dof] for i in range(path.getStateCount())])
         path_valid = bool(CollisionChecker(robot, problem.environment).check(states).all())
-    return {"solved": solved, "time": elapsed, "checks": work.states_checked,
-            "motions": work.motions_checked, "path_valid": path_valid}
+    return {"solved": run.solved, "time": run.time, "checks": run.work.states_checked,
+            "motions": run.work.motions_checked, "path_valid": path_valid}
 
 
 def main() -> None:

@@ -27,7 +27,8 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ompl_balance import BalancedRRTConnect, CountingValidityChecker, read_work
+from ompl_balance import BalancedRRTConnect, CountingValidityChecker
+from ompl_balance.counting import measured_solve
 from ompl_balance.problems import get_problem
 
 DIM = 7
@@ -89,20 +90,9 @@ PLANNERS = {
 
 def run(make_setup, make_planner, time_limit: float) -> dict:
     ss = make_setup()
-    si = ss.getSpaceInformation()
-    ss.setPlanner(make_planner(si))
-    ss.setup()
-    before = read_work(si)
-    began = time.perf_counter()
-    ss.solve(time_limit)
-    elapsed = time.perf_counter() - began
-    work = read_work(si) - before
-    return {
-        "solved": ss.haveExactSolutionPath(),
-        "time": elapsed,
-        "checks": work.states_checked,
-        "motions": work.motions_checked,
-    }
+    ss.setPlanner(make_planner(ss.getSpaceInformation()))
+    run = measured_solve(ss, time_limit)
+    return {"solved": run.solved, "time": run.time, "checks": run.work.states_checked, "motions": run.work.motions_checked}
 
 
 def main() -> None:

@@ -24,14 +24,13 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
-import time
 from pathlib import Path
 
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ompl_balance.counting import read_work
+from ompl_balance.counting import measured_solve
 from ompl_balance.planners import PRESETS
 from ompl_balance.problems import PROBLEMS
 
@@ -67,7 +66,7 @@ def mbm_problems(count: int) -> dict:
     """``name -> make_setup`` for the first ``count`` problems of each Panda scenario."""
     from ompl_balance.mbm import load_mbm
     from ompl_balance.robots import load_panda_vamp
-    from ompl_balance.validity import CollisionChecker, setup_robot, space_for
+    from ompl_balance.validity import CollisionChecker
 
     robot = load_panda_vamp(DATA / "robots" / "panda_vamp")
     problems = {}
@@ -76,21 +75,7 @@ def mbm_problems(count: int) -> dict:
             checker = CollisionChecker(robot, problem.environment)
 
             def make_setup(problem=problem, checker=checker):
-                ss = og.SimpleSetup(space_for(robot))
-                setup_robot(ss, checker)
-                si = ss.getSpaceInformation()
-                start = si.allocState()
-                for i, value in enumerate(problem.start):
-                    start[i] = float(value)
-                ss.setStartState(start)
-                goals = ob.GoalStates(si)
-                for configuration in problem.goals:
-                    goal = si.allocState()
-                    for i, value in enumerate(configuration):
-                        goal[i] = float(value)
-                    goals.addState(goal)
-                ss.setGoal(goals)
-                return ss
+                return problem.simple_setup(robot, checker)
 
             problems[f"{problem.scenario}#{problem.id}"] = make_setup
     return problems
@@ -101,12 +86,7 @@ def run(make_setup, make_planner, time_limit: float) -> dict:
     si = ss.getSpaceInformation()
     planner = make_planner(si)
     ss.setPlanner(planner)
-    ss.setup()
-    before = read_work(si)
-    began = time.perf_counter()
-    ss.solve(time_limit)
-    elapsed = time.perf_counter() - began
-    work = read_work(si) - before
+    run = measured_solve(ss, time_limit)
     stats = getattr(planner, "stats", None)
     if stats is not None:
         nodes = stats.start_tree_size + stats.goal_tree_size
@@ -114,7 +94,7 @@ def run(make_setup, make_planner, time_limit: float) -> dict:
         data = ob.PlannerData(si)
         ss.getPlannerData(data)
         nodes = data.numVertices()
-    return {"solved": ss.haveExactSolutionPath(), "time": elapsed, "queries": work.states_checked, "nodes": nodes}
+    return {"solved": run.solved, "time": run.time, "queries": run.work.states_checked, "nodes": nodes}
 
 
 def main() -> None:

@@ -8,7 +8,6 @@ collision-checking work of each planner. Run: ``python examples/panda_table.py``
 import time
 
 import numpy as np
-from ompl import base as ob
 from ompl import geometric as og
 
 from ompl_balance.counting import read_work

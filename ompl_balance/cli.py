@@ -19,7 +19,6 @@ tcp://HOST:PORT`` or ``--dask local:N`` on a Dask cluster (the ``distributed`` e
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tempfile
 from collections.abc import Sequence

@@ -17,10 +17,12 @@ A plain Python callable given to ``si.setStateValidityChecker`` counts nothing, 
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from ompl import base as ob
+from ompl import geometric as og
 
 
 class CountingValidityChecker(ob.StateValidityChecker):
@@ -97,3 +99,27 @@ def read_work(si: ob.SpaceInformation) -> WorkCount:
     else:
         motions = validator.getCheckedMotionCount()
     return WorkCount(states, motions)
+
+
+@dataclass(frozen=True)
+class MeasuredSolve:
+    """One ``ss.solve``: its status, whether it found an exact path, wall time (s) and work."""
+
+    status: ob.PlannerStatus
+    solved: bool
+    time: float
+    work: WorkCount
+
+
+def measured_solve(ss: og.SimpleSetup, time_limit: float) -> MeasuredSolve:
+    """``ss.solve(time_limit)`` with its wall time and the work its checkers counted.
+
+    Sets ``ss`` up first, so that setup (e.g. wrapping a checker to count) is not timed.
+    """
+    ss.setup()
+    si = ss.getSpaceInformation()
+    before = read_work(si)
+    began = time.perf_counter()
+    status = ss.solve(time_limit)
+    elapsed = time.perf_counter() - began
+    return MeasuredSolve(status, bool(ss.haveExactSolutionPath()), elapsed, read_work(si) - before)

@@ -277,25 +277,10 @@ def _mbm_setup(path: str, problem_id: int, robot_dir: str) -> og.SimpleSetup:
     """A MotionBenchMaker problem on VAMP's Panda layout: batched checker, all goals as ``GoalStates``."""
     from .mbm import load_mbm
     from .robots import load_panda_vamp
-    from .validity import CollisionChecker, setup_robot, space_for
 
     robot = load_panda_vamp(robot_dir)
     problem = next(p for p in load_mbm(path, robot.joint_names) if p.id == problem_id)
-    ss = og.SimpleSetup(space_for(robot))
-    setup_robot(ss, CollisionChecker(robot, problem.environment))
-    si = ss.getSpaceInformation()
-    start = si.allocState()
-    for i, value in enumerate(problem.start):
-        start[i] = float(value)
-    goals = ob.GoalStates(si)
-    for values in problem.goals:
-        goal = si.allocState()
-        for i, value in enumerate(values):
-            goal[i] = float(value)
-        goals.addState(goal)
-    ss.setStartState(start)
-    ss.setGoal(goals)
-    return ss
+    return problem.simple_setup(robot)
 
 
 # -- the experiment ---------------------------------------------------------------------

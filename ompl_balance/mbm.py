@@ -13,8 +13,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
 
-from .validity import Environment
+from .kinematics import RobotModel
+from .validity import CollisionChecker, Environment, setup_robot, space_for
 
 
 @dataclass(frozen=True)
@@ -27,6 +30,26 @@ class MBMProblem:
     goals: np.ndarray
     environment: Environment
     valid: bool  # the file's flag: start and a goal collision-free under VAMP's sphere model
+
+    def simple_setup(self, robot: RobotModel, checker: CollisionChecker | None = None) -> og.SimpleSetup:
+        """A ``SimpleSetup`` for this problem: ``robot``'s joint space, the package's checker
+        and motion validator (``checker``, or a new one for this environment), the start,
+        and every goal as ``ob.GoalStates`` (any goal is a success)."""
+        ss = og.SimpleSetup(space_for(robot))
+        setup_robot(ss, checker or CollisionChecker(robot, self.environment))
+        si = ss.getSpaceInformation()
+        start = si.allocState()
+        for i, value in enumerate(self.start):
+            start[i] = float(value)
+        goals = ob.GoalStates(si)
+        for configuration in self.goals:
+            goal = si.allocState()
+            for i, value in enumerate(configuration):
+                goal[i] = float(value)
+            goals.addState(goal)
+        ss.setStartState(start)
+        ss.setGoal(goals)
+        return ss
 
 
 def load_mbm(path, joint_names: list[str] | None = None) -> list[MBMProblem]:

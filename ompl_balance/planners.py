@@ -552,6 +552,9 @@ class BalancedRRTConnect(ob.Planner):
         work_before = read_work(si)
         rng = np.random.default_rng(self._seed or self._rng.uniformInt(1, 2**31 - 2))
         self._points = points_for(si, rng)
+        # Per solve, not per step: the calls the grow step makes, and whether a step can stall.
+        self._is_valid, self._check_motion = si.isValid, si.checkMotion
+        self._step_may_stall = self._points.may_stall(self._range)
         if self._start_tree is None:
             self._start_tree, self._goal_tree = self._points.new_tree(), self._points.new_tree()
             self._failures = {self._start_tree: NodeFailures(), self._goal_tree: NodeFailures()}
@@ -689,10 +692,6 @@ class BalancedRRTConnect(ob.Planner):
             return by_exhaustion
         return None
 
-    def _nearest_by_failures(self, tree, target) -> tuple[int, float]:
-        """The node ``nearest_policy`` extends ``tree`` from towards ``target``, and its distance."""
-        return self._find_by_failures(tree, target)
-
     def _target_sampler(self, rng: np.random.Generator) -> Callable[[bool], tuple]:
         """``sample(grow_start) -> (target, nearest)`` of ``sample_policy``.
 
@@ -741,7 +740,7 @@ class BalancedRRTConnect(ob.Planner):
                     if self._find_by_failures is None:
                         nearest, _ = tree.nearest(point)
                     else:
-                        nearest, _ = self._nearest_by_failures(tree, point)
+                        nearest, _ = self._find_by_failures(tree, point)
                     if random() < node_quality(tree_costs.values[nearest], optimal, tree_costs.max, min_quality):
                         return point, nearest
                     self._sampler_rejections += 1
@@ -792,21 +791,20 @@ class BalancedRRTConnect(ob.Planner):
             if self._find_by_failures is None:
                 nearest, distance = tree.nearest(target)
             else:
-                nearest, distance = self._nearest_by_failures(tree, target)
+                nearest, distance = self._find_by_failures(tree, target)
         else:
             distance = points.distance(tree.state(nearest), target)
         near = tree.state(nearest)
         reach = distance <= self._range
         new = target if reach else points.interpolate(near, target, self._range / distance)
-        if not reach and points.equal(near, new):
+        if not reach and self._step_may_stall and points.equal(near, new):
             return Grow.TRAPPED, NO_PARENT
 
-        si = self.getSpaceInformation()
         near_state, new_state = points.ompl_state(near, 0), points.ompl_state(new, 1)
         if from_start:
-            valid = si.checkMotion(near_state, new_state)
+            valid = self._check_motion(near_state, new_state)
         else:
-            valid = si.isValid(new_state) and si.checkMotion(new_state, near_state)
+            valid = self._is_valid(new_state) and self._check_motion(new_state, near_state)
         if not valid:
             if self._find_by_failures is not None:
                 self._failures[tree].record(nearest)

@@ -37,7 +37,7 @@ from typing import Any
 from ompl import base as ob
 from ompl import util as ou
 
-from .counting import read_work
+from .counting import measured_solve
 from .experiment import Experiment, RunTask, planner_params
 
 #: OMPL's planner status names -> the index the OMPL log's ``status`` enum uses.
@@ -90,19 +90,14 @@ def execute(task: RunTask) -> Record:
     if run_seeded:
         planner.setSeed(task.seed)  # this package's planners: the run's seed, unless the experiment sets one
     ss.setPlanner(planner)
-    ss.setup()
-    before = read_work(si)
-    began = time.perf_counter()
-    status = ss.solve(task.time_limit)
-    elapsed = time.perf_counter() - began
-    work = read_work(si) - before
-    status_name = _status_name(status)
+    run = measured_solve(ss, task.time_limit)
+    status_name = _status_name(run.status)
     properties: dict[str, Any] = {
-        "time REAL": elapsed,
+        "time REAL": run.time,
         "status ENUM": STATUS_INDEX[status_name],
-        "solved BOOLEAN": int(ss.haveExactSolutionPath()),
-        "validity checks INTEGER": work.states_checked,
-        "motion checks INTEGER": work.motions_checked,
+        "solved BOOLEAN": int(run.solved),
+        "validity checks INTEGER": run.work.states_checked,
+        "motion checks INTEGER": run.work.motions_checked,
     }
     if ss.haveSolutionPath():
         path = ss.getSolutionPath()  # keep the owner while reading it

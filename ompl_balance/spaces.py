@@ -75,6 +75,15 @@ class RealVectorPoints:
         """Equal within OMPL's ``RealVectorStateSpace::equalStates`` tolerance."""
         return float(np.abs(a - b).max()) <= _EQUAL_TOLERANCE
 
+    def may_stall(self, step: float) -> bool:
+        """Whether a move of length ``step`` can round back onto its start point.
+
+        Only when ``step`` is within rounding of the coordinates' magnitude; planners
+        skip the no-progress test otherwise.
+        """
+        largest = max(float(np.abs(self.low).max(initial=0.0)), float(np.abs(self.high).max(initial=0.0)))
+        return step <= 4.0 * _EQUAL_TOLERANCE * largest * math.sqrt(self.dim)
+
     def is_finite(self, state: ob.State) -> bool:
         """``False`` when an OMPL state has a NaN or infinite value (bounds checks miss NaN)."""
         return all(math.isfinite(value) for value in state[0 : self.dim])
@@ -96,11 +105,14 @@ class RealVectorPoints:
         return state
 
     def segment_points(self, a: np.ndarray, b: np.ndarray) -> list[np.ndarray]:
-        """Points after ``a`` up to and including ``b`` at the space's resolution.
+        """Points after ``a`` up to and including ``b``: the states a motion check of ``(a, b)`` decided.
 
-        The same states ``si.getMotionStates`` yields for ``validSegmentCount(a, b)``.
+        ``interpolate(a, b, j / n)`` for ``j = 1..n``, ``n = validSegmentCount(a, b)``:
+        the states OMPL's ``DiscreteMotionValidator`` checks, so every state added is
+        known valid. (OMPL's ``getMotionStates`` would place them at ``j / (n + 1)``,
+        between the checked ones.)
         """
-        count = self._space.validSegmentCount(self.ompl_state(a, 0), self.ompl_state(b, 1)) + 1
+        count = self._space.validSegmentCount(self.ompl_state(a, 0), self.ompl_state(b, 1))
         return [self.interpolate(a, b, step / count) for step in range(1, count)] + [b]
 
 
@@ -127,6 +139,11 @@ class StatePoints:
         self._space.interpolate(a, b, t, state)
         return state
 
+    @staticmethod
+    def may_stall(step: float) -> bool:
+        """Always: an arbitrary space's ``interpolate`` may make no progress (see RRTConnect.cpp)."""
+        return True
+
     def is_finite(self, state: ob.State) -> bool:
         """``False`` when an OMPL state has a NaN or infinite value.
 
@@ -148,7 +165,8 @@ class StatePoints:
         return point
 
     def segment_points(self, a: ob.State, b: ob.State) -> list[ob.State]:
-        count = self._space.validSegmentCount(a, b) + 1
+        """As :meth:`RealVectorPoints.segment_points`: the states a motion check of ``(a, b)`` decided."""
+        count = self._space.validSegmentCount(a, b)
         return [self.interpolate(a, b, step / count) for step in range(1, count)] + [self.new_state(b)]
 
 

@@ -86,7 +86,9 @@ class ArrayTree(_Links):
     def __init__(self, dim: int, capacity: int = 1024) -> None:
         super().__init__(capacity)
         self._states = np.empty((capacity, dim))
-        self._squared_norms = np.empty(capacity)  # |state|^2 per node, for nearest()
+        # |state|^2 per node for nearest() on large trees, filled in batches when needed
+        self._squared_norms = np.empty(capacity)
+        self._normed = 0  # nodes whose squared norm is filled in
         self._largest_norm = 0.0
 
     @property
@@ -104,9 +106,6 @@ class ArrayTree(_Links):
             self._states = np.concatenate([self._states, np.empty_like(self._states)])
             self._squared_norms = np.concatenate([self._squared_norms, np.empty_like(self._squared_norms)])
         self._states[index] = state
-        squared_norm = float(state @ state)
-        self._squared_norms[index] = squared_norm
-        self._largest_norm = max(self._largest_norm, math.sqrt(squared_norm))
         return index
 
     def nearest(self, state: np.ndarray) -> tuple[int, float]:
@@ -122,6 +121,12 @@ class ArrayTree(_Links):
             squared = np.einsum("ij,ij->i", offsets, offsets)
             index = int(squared.argmin())
             return index, math.sqrt(squared[index])
+        if self._normed < self.size:  # norms of the nodes added since the last large-tree query
+            fresh = states[self._normed :]
+            norms = np.einsum("ij,ij->i", fresh, fresh)
+            self._squared_norms[self._normed : self.size] = norms
+            self._largest_norm = max(self._largest_norm, math.sqrt(float(norms.max())))
+            self._normed = self.size
         scores = self._squared_norms[: self.size] - 2.0 * (states @ state)
         index = int(scores.argmin())
         reach = self._largest_norm + math.sqrt(float(state @ state))
@@ -132,6 +137,11 @@ class ArrayTree(_Links):
             index = int(ties[np.einsum("ij,ij->i", offsets, offsets).argmin()])
         offset = states[index] - state
         return index, math.sqrt(float(offset @ offset))
+
+    def clear(self) -> None:
+        super().clear()
+        self._normed = 0
+        self._largest_norm = 0.0
 
     def distances(self, state: np.ndarray) -> np.ndarray:
         """Euclidean distance from every node to ``state``, ``(len(tree),)``."""

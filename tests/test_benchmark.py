@@ -13,7 +13,7 @@ from ompl_balance.benchmark import bench, compare_experiment, parse_planners
 from ompl_balance.cli import main
 from ompl_balance.experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec, load_experiment, run_seed
 from ompl_balance.ompl_log import write_logs
-from ompl_balance.runner import ResultStore, run_isolated
+from ompl_balance.runner import run_isolated
 from ompl_balance.summary import summarize
 
 SHARED = Path(__file__).resolve().parents[2] / "shared"

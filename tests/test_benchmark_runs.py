@@ -13,7 +13,6 @@ from pathlib import Path
 
 import pytest
 from ompl import base as ob
-from ompl import geometric as og
 
 from ompl_balance.benchmark import bench
 from ompl_balance.experiment import Experiment, PlannerSpec, ProblemSpec

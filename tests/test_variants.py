@@ -231,15 +231,20 @@ def test_exhausted_policy_never_extends_an_exhausted_node(monkeypatch):
     planner.setNearestPolicy("exhausted")
     planner.setExhaustedAfter(2)
     picks = []
-    real = planner._nearest_by_failures
+    make_finder = planner._failure_nearest  # the policy's node finder, built once per solve
 
-    def checked(tree, target):
-        node, distance = real(tree, target)
-        counts = planner._failures[tree].counts(len(tree))
-        picks.append(counts[node] < 2 or bool(np.all(counts >= 2)))
-        return node, distance
+    def checking_finder():
+        find = make_finder()
 
-    planner._nearest_by_failures = checked
+        def checked(tree, target):
+            node, distance = find(tree, target)
+            counts = planner._failures[tree].counts(len(tree))
+            picks.append(counts[node] < 2 or bool(np.all(counts >= 2)))
+            return node, distance
+
+        return checked
+
+    monkeypatch.setattr(planner, "_failure_nearest", checking_finder)
     ss.setPlanner(planner)
     assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
     assert len(picks) > 10 and all(picks)
