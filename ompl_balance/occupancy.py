@@ -68,7 +68,9 @@ class OccupancyGrid:
         return float((~self.occupied).sum()) * self.resolution**2
 
     def is_free(self, x: float, y: float) -> bool:
-        """``True`` when ``(x, y)`` (m) lies in a free cell of the grid."""
+        """``True`` when ``(x, y)`` (m) lies in a free cell of the grid (``False`` for NaN or infinite)."""
+        if not (math.isfinite(x) and math.isfinite(y)):
+            return False
         col = math.floor((x - self.origin[0]) / self.resolution)
         row = math.floor((y - self.origin[1]) / self.resolution)
         rows, cols = self.occupied.shape

@@ -1212,6 +1212,9 @@ class BallRadiusRRTstar(ob.Planner):
         points, tree = self._points, self._tree
         inputs = self.getPlannerInputStates()
         while (state := inputs.nextStart()) is not None:
+            if not points.is_finite(state):
+                ou.OMPL_WARN(f"{name}: Skipping start state with non-finite values")
+                continue
             root = self._add_node(points.from_state(state), NO_PARENT, 0.0)
             if goal.isSatisfied(state):
                 self._goal_nodes.append(root)
@@ -1236,6 +1239,8 @@ class BallRadiusRRTstar(ob.Planner):
                 and rng.random() < self._goal_bias
             ):
                 sampleable.sampleGoal(goal_sample)
+                if not points.is_finite(goal_sample):
+                    continue
                 target = points.from_state(goal_sample)
             else:
                 target = points.sample()

@@ -26,7 +26,7 @@ from .experiment import Experiment
 from .planners import GOAL_TAG, START_TAG, BalancedRRTConnect
 from .problems import PROBLEMS
 from .runner import Record, ResultStore
-from .summary import format_csv, format_markdown, summarize
+from .summary import format_csv, format_markdown, pooled_by_scenario, summarize
 
 
 def _pyplot():
@@ -152,6 +152,11 @@ def plot_folder(out: str | Path, baseline: str | None = None, tree_iterations: i
     (folder / "summary.md").write_text(format_markdown(summaries, baseline) + "\n")
     (folder / "summary.csv").write_text(format_csv(summaries))
     written = [folder / "summary.md", folder / "summary.csv"]
+    if any("." in problem.name for problem in experiment.problems):  # MotionBenchMaker: also per scenario
+        pooled = summarize(pooled_by_scenario(records), baseline, labels)
+        (folder / "summary_by_scenario.md").write_text(format_markdown(pooled, baseline) + "\n")
+        (folder / "summary_by_scenario.csv").write_text(format_csv(pooled))
+        written += [folder / "summary_by_scenario.md", folder / "summary_by_scenario.csv"]
     for problem in experiment.problems:
         if any(r["problem"] == problem.name for r in records):
             written.append(plot_problem(records, problem.name, labels, folder / f"{problem.name}.png"))

@@ -14,6 +14,7 @@ so stock OMPL planners and this package's planners are measured alike.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -35,7 +36,9 @@ class BoxWorld2D:
         self.boxes = tuple(tuple(float(v) for v in box) for box in boxes)
 
     def is_free(self, x: float, y: float) -> bool:
-        """``True`` when the point ``(x, y)`` lies in no box."""
+        """``True`` when the point ``(x, y)`` lies in no box (``False`` for NaN or infinite)."""
+        if not (math.isfinite(x) and math.isfinite(y)):
+            return False
         for x_min, y_min, x_max, y_max in self.boxes:
             if x_min <= x <= x_max and y_min <= y <= y_max:
                 return False

@@ -112,6 +112,14 @@ def summarize(records: Iterable[Record], baseline: str, order: Sequence[str] = (
     return summaries
 
 
+def pooled_by_scenario(records: Iterable[Record]) -> list[Record]:
+    """The records with each MotionBenchMaker problem (``scenario.NNN``) renamed to its scenario.
+
+    Summarizing these pools every run of a scenario's problems into one cell per planner.
+    """
+    return [{**record, "problem": record["problem"].split(".")[0]} for record in records]
+
+
 def _with_interval(value: float, interval: Interval, digits: int) -> str:
     if math.isnan(value):
         return "-"

@@ -235,3 +235,13 @@ def test_bad_time_limit_is_rejected():
     ss.setup()
     with pytest.raises(ValueError, match="time limit"):
         planner.solve(-1.0)
+
+
+@pytest.mark.parametrize("values", [(float("nan"), 5.0), (math.inf, 5.0)])
+def test_non_finite_start_is_invalid_start(values):
+    ss = rooms_problem().setup()
+    start = ss.getStateSpace().allocState()
+    start[0], start[1] = values
+    ss.setStartState(start)
+    ss.setPlanner(BallRadiusRRTstar(ss.getSpaceInformation()))
+    assert ss.solve(1.0) == ob.PlannerStatus.INVALID_START
