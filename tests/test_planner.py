@@ -3,10 +3,7 @@
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 import time
-from pathlib import Path
 
 import pytest
 from ompl import base as ob
@@ -16,10 +13,10 @@ from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect, balance_choice, read_work, tree_size_ratio
 from ompl_balance.problems import PROBLEMS, BoxWorld2D, get_problem
+from fresh_process import run_with_seed
 from pathcheck import assert_valid_solution
 
 ou.setLogLevel(ou.LOG_WARN)
-REPO = Path(__file__).resolve().parents[1]
 
 
 # -- the balancing rule --------------------------------------------------------------
@@ -440,10 +437,7 @@ print([round(path.getState(i)[j], 12) for i in range(path.getStateCount()) for j
 
 
 def seeded_path(seed: int) -> str:
-    result = subprocess.run(
-        [sys.executable, "-c", SEEDED_RUN, str(seed)], capture_output=True, text=True, timeout=120, cwd=REPO, check=True
-    )
-    return result.stdout.strip()
+    return run_with_seed(SEEDED_RUN, seed)
 
 
 def test_same_seed_same_path_in_a_fresh_process():

@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,9 +12,9 @@ from ompl import util as ou
 
 from ompl_balance.problems import BoxWorld2D, get_problem
 from ompl_balance.samplers import BridgeTestValidStateSampler, GaussianValidStateSampler, PassageSampler
+from fresh_process import run_with_seed
 
 ou.setLogLevel(ou.LOG_WARN)
-REPO = Path(__file__).resolve().parents[1]
 SAMPLERS = [GaussianValidStateSampler, BridgeTestValidStateSampler, PassageSampler]
 
 
@@ -180,10 +177,7 @@ print(out)
 
 
 def seeded_samples(seed: int) -> str:
-    result = subprocess.run(
-        [sys.executable, "-c", SEEDED_SAMPLES, str(seed)], capture_output=True, text=True, timeout=120, cwd=REPO, check=True
-    )
-    return result.stdout.strip()
+    return run_with_seed(SEEDED_SAMPLES, seed)
 
 
 def test_ompl_seed_repeats_the_samples():
