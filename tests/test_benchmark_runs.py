@@ -116,7 +116,6 @@ def test_a_killed_sweep_resumes_without_repeating_or_losing_runs(tmp_path):
     assert "32 runs in" in finished.stdout
 
 
-@pytest.mark.slow
 def test_dask_cluster_gives_the_results_of_the_local_pool(tmp_path, monkeypatch):
     pytest.importorskip("dask.distributed")
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(REPO), str(TESTS), os.environ.get("PYTHONPATH", "")]))
