@@ -349,8 +349,9 @@ class BalancedRRTConnect(ob.Planner):
         lab's "control chosen"); a uniform sample kept with probability
         :func:`node_quality` of its nearest node (``min_quality``); a sample of the
         space information's valid-state sampler (``si.allocValidStateSampler()``, or
-        the allocator given to :meth:`setValidStateSamplerAllocator`). A rejecting
-        policy gives up the iteration after :data:`SAMPLE_ATTEMPTS` draws.
+        the allocator given to :meth:`setValidStateSamplerAllocator`), or a uniform
+        sample when the valid-state sampler finds none (e.g. no obstacle near). The
+        rejecting policies give up the iteration after :data:`SAMPLE_ATTEMPTS` draws.
     ``goal_bias`` (float in [0, 1], default 0.05), ``min_quality`` (float in [0, 1], default 0)
     ``seed`` (int >= 0, default 0)
         0: each solve draws its seed from an OMPL ``RNG`` (reproducible from
@@ -505,6 +506,13 @@ class BalancedRRTConnect(ob.Planner):
     def getSeed(self) -> int:  # noqa: N802
         return self._seed
 
+    @property
+    def draws_from_ompl_rng(self) -> bool:
+        """True when a solve draws from OMPL's global RNG (``sample_policy = valid_sampler``):
+        the ``seed`` parameter cannot repeat such a solve, ``ompl.util.RNG.setSeed`` at the
+        start of a fresh process can."""
+        return self._sample_policy == "valid_sampler"
+
     def setValidStateSamplerAllocator(  # noqa: N802
         self, allocator: Callable[[ob.SpaceInformation], ob.ValidStateSampler] | None
     ) -> None:
@@ -526,7 +534,7 @@ class BalancedRRTConnect(ob.Planner):
 
     def _check_policies(self) -> None:
         """Refuse combinations of policies and parameters that cannot do what they say."""
-        if self._sample_policy == "valid_sampler" and self._seed > 0:
+        if self.draws_from_ompl_rng and self._seed > 0:
             raise ValueError(
                 f"{self.getName()}: sample_policy=valid_sampler with seed={self._seed}: a valid-state sampler "
                 "draws from OMPL's RNG, which the seed parameter cannot repeat; use seed=0 (and "
@@ -756,8 +764,10 @@ class BalancedRRTConnect(ob.Planner):
             found = sampler.sample(state)
             self._sampler_checks += checker.counters()["states_checked"] - before
             if not found:
+                # No state near an obstacle within the sampler's attempts (free space has
+                # none): a uniform target keeps the planner growing, as RRT-Connect would.
                 self._sampler_rejections += 1
-                return None, None
+                return uniform(), None
             return points.from_state(state), None
 
         return from_valid_sampler

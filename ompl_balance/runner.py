@@ -86,9 +86,12 @@ def execute(task: RunTask) -> Record:
     ss = task.problem.build()
     si = ss.getSpaceInformation()
     planner = task.planner.build(si)
-    run_seeded = "seed" not in task.planner.params and hasattr(planner, "setSeed")
+    # This package's planners get the run's seed, unless the experiment sets one or the
+    # planner draws from OMPL's RNG (a valid-state sampler), which the setSeed above repeats.
+    run_seeded = ("seed" not in task.planner.params and hasattr(planner, "setSeed")
+                  and not getattr(planner, "draws_from_ompl_rng", False))
     if run_seeded:
-        planner.setSeed(task.seed)  # this package's planners: the run's seed, unless the experiment sets one
+        planner.setSeed(task.seed)
     ss.setPlanner(planner)
     run = measured_solve(ss, task.time_limit)
     status_name = _status_name(run.status)

@@ -123,11 +123,13 @@ def test_dask_cluster_gives_the_results_of_the_local_pool(tmp_path, monkeypatch)
         name="same",
         problems=(ProblemSpec("open", "builtin", "open"), ProblemSpec("narrow_gap", "builtin", "narrow_gap")),
         planners=(PlannerSpec("RRTConnect", "RRTConnect"), PlannerSpec("BalancedRRTConnect", "BalancedRRTConnect"),
-                  PlannerSpec("alternating", "BalancedRRTConnect", params={"balance_tree_sizes": "0"})),
+                  PlannerSpec("alternating", "BalancedRRTConnect", params={"balance_tree_sizes": "0"}),
+                  # draws from OMPL's RNG (valid-state sampler): repeated by the run's process seed
+                  PlannerSpec("GaussianPassageRRTConnect", "GaussianPassageRRTConnect")),
         runs=3, time_limit=10.0, seed=5)
     local = bench(experiment, tmp_path / "local", jobs=2, progress=False)
     distributed = bench(experiment, tmp_path / "dask", dask="local:2", progress=False)
-    assert len(local) == len(distributed) == 18
+    assert len(local) == len(distributed) == 24
     assert all(r["status"] == "EXACT_SOLUTION" for r in local + distributed)
     assert sorted(map(deterministic, local)) == sorted(map(deterministic, distributed))
     logs = sorted(p.name for p in (tmp_path / "dask" / "logs").glob("*.log"))

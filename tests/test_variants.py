@@ -294,6 +294,23 @@ def test_valid_sampler_policy_draws_from_the_space_informations_sampler():
     assert_valid_solution(ss, problem.world(), [start], ss.getGoal().isSatisfied)
 
 
+def test_passage_sampler_in_free_space_falls_back_to_uniform_targets():
+    # no obstacles: the passage sampler can never find a state near one (it used to stall
+    # the planner until the time limit)
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda state: True)
+    start, goal = space.allocState(), space.allocState()
+    start[0], start[1], goal[0], goal[1] = 0.05, 0.05, 0.95, 0.95
+    ss.setStartAndGoalStates(start, goal)
+    planner = planners.GaussianPassageRRTConnect(ss.getSpaceInformation())
+    planner.setRange(0.1)  # several iterations, so the sampler is asked
+    ss.setPlanner(planner)
+    assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.stats.sampler_rejections > 0
+
+
 def test_swaps_by_cause_add_up():
     ss = get_problem("bug_trap").setup()
     planner = BalancedRRTConnect(ss.getSpaceInformation())
