@@ -4,15 +4,15 @@
 :class:`~ompl_balance.kinematics.RobotModel` among the obstacles of an
 :class:`Environment`, for many configurations at once:
 
-1. batched forward kinematics (one numpy pass for all configurations),
-2. a conservative numpy pre-filter: spheres covering each link geometry against an
-   oriented box around each obstacle, and against each other for the self-collision
-   pairs; only what may touch goes on to
-3. FCL's exact test, pair by pair, on FCL objects built once (only their transforms
+1. forward kinematics and a conservative screening, compiled, for all configurations
+   in one call (:mod:`ompl_balance.screening`): spheres covering each link geometry
+   against an oriented box around each obstacle, and against each other for the
+   self-collision pairs; only the pairs it cannot clear go on to
+2. FCL's exact test, pair by pair, on FCL objects built once (only their transforms
    are updated).
 
-The answer is FCL's: the pre-filter only skips pairs whose bounding volumes are
-apart, which FCL would report free. ``prefilter=False`` skips step 2 and checks the
+The answer is FCL's: the screening only skips pairs whose bounding volumes are
+apart, which FCL would report free. ``prefilter=False`` skips the screening and checks the
 environment through FCL's broad phase (a dynamic AABB tree of the obstacles against
 one of the robot's geometries) and every self-collision pair with FCL; it is the
 straightforward reference the tests compare with.
@@ -33,10 +33,7 @@ from ompl import geometric as og
 
 from .geometry import Shape, fcl_transform, pose_matrix
 from .kinematics import RobotModel
-
-#: Slack (m) added to bounding-volume tests so that rounding never makes the pre-filter miss a contact.
-PREFILTER_SLACK = 1e-6
-
+from .screening import build_volumes, screen
 
 @dataclass(frozen=True, eq=False)
 class Obstacle:
@@ -113,7 +110,8 @@ class CollisionChecker:
     environment:
         The obstacles (none if omitted).
     spheres_per_geometry:
-        How many spheres cover each link geometry in the pre-filter (tighter with more).
+        How many small spheres cover each link geometry in the screening (tighter with
+        more; see :mod:`ompl_balance.screening`).
     prefilter:
         ``False`` checks every pair with FCL (through FCL's broad phase for the environment).
     """
@@ -132,49 +130,15 @@ class CollisionChecker:
         self._origin_is_identity = [bool(np.array_equal(g.origin, np.eye(4))) for g in geometries]
         self._links = [fcl.CollisionObject(g.shape.fcl_geometry(), fcl.Transform()) for g in geometries]
         self._obstacles = [fcl.CollisionObject(o.shape.fcl_geometry(), fcl_transform(o.pose)) for o in obstacles]
-        self._pairs = np.array(robot.self_collision_pairs, dtype=int).reshape(-1, 2)
+        self._pairs = [tuple(pair) for pair in robot.self_collision_pairs]
         self._environment_manager = fcl.DynamicAABBTreeCollisionManager()
         self._environment_manager.registerObjects(self._obstacles)
         self._environment_manager.setup()
 
-        # pre-filter spheres, sorted by geometry. World centres (n, 3, spheres) come out of one
-        # product: body poses laid side by side (n, 3, 4 * bodies) @ body-frame centres placed in
-        # their body's rows of a (4 * bodies, spheres) matrix.
-        spheres = [g.shape.bounding_spheres(spheres_per_geometry) for g in geometries]
-        radius = np.concatenate([r for _, r in spheres]) if spheres else np.zeros(0)
-        owner = np.repeat(np.arange(len(geometries)), [len(r) for _, r in spheres]).astype(int)
-        self._geometry_starts = np.searchsorted(owner, np.arange(len(geometries)))
-        self._sphere_centre = np.zeros((4 * robot.body_count, len(radius)))
-        column = 0
-        for g, (centres, _) in zip(geometries, spheres):
-            for centre in centres @ g.origin[:3, :3].T + g.origin[:3, 3]:
-                self._sphere_centre[4 * g.body:4 * g.body + 4, column] = (*centre, 1.0)
-                column += 1
-        # obstacles: the six face planes of a box around each, face-major rows (face * obstacles + o):
-        # a sphere can touch box o only if  normal . centre - (normal . box centre + half) <= radius
-        # for all six faces, i.e. if the largest of  face @ centre + face_offset  is <= 0
-        normals, offsets = [], []
-        for side in (1.0, -1.0):
-            for axis in range(3):
-                for o in obstacles:
-                    box_pose, half = o.shape.bounding_box()
-                    pose = o.pose @ box_pose
-                    normal = side * pose[:3, axis]
-                    normals.append(normal)
-                    offsets.append(-(normal @ pose[:3, 3] + half[axis]))
-        self._face_normal = np.array(normals).reshape(-1, 3)
-        self._face_offset = (np.array(offsets)[:, None] - (radius + PREFILTER_SLACK)).reshape(6, len(obstacles), len(radius))
-        # self-collision: every sphere pair of every self-collision geometry pair, sorted by pair
-        pair_a, pair_b, pair_of = [], [], []
-        for p, (a, b) in enumerate(self._pairs):
-            sa, sb = np.flatnonzero(owner == a), np.flatnonzero(owner == b)
-            pair_a.append(np.repeat(sa, len(sb)))
-            pair_b.append(np.tile(sb, len(sa)))
-            pair_of.append(np.full(len(sa) * len(sb), p))
-        self._pair_sphere_a = np.concatenate(pair_a) if pair_a else np.zeros(0, dtype=int)
-        self._pair_sphere_b = np.concatenate(pair_b) if pair_b else np.zeros(0, dtype=int)
-        self._pair_starts = np.searchsorted(np.concatenate(pair_of) if pair_of else [], np.arange(len(self._pairs)))
-        self._pair_reach = (radius[self._pair_sphere_a] + radius[self._pair_sphere_b] + PREFILTER_SLACK) ** 2
+        self._volumes = build_volumes(robot, obstacles, spheres_per_geometry)
+        # the single-state path (OMPL's isValid) reuses its output arrays
+        self._one = self._screen_outputs(1)
+        self._screen(np.zeros((1, robot.dof)), self._one)  # compile or load the kernel now, not in a solve
 
     # ------------------------------------------------------------------ public API
 
@@ -182,13 +146,14 @@ class CollisionChecker:
         """Validity (collision-free) of each configuration: ``q`` (n, dof) or (dof,) -> bool (n,)."""
         q = self.robot.as_array(q)
         self.counter.states_checked += len(q)
-        poses = self.robot.body_poses(q)
         if not self.prefilter:
-            return np.array([self._free_reference(p) for p in poses], dtype=bool)
-        maybe, env, own = self._candidates(poses)
+            return np.array([self._free_reference(p) for p in self.robot.body_poses(q)], dtype=bool)
+        outputs = self._screen_outputs(len(q))
+        maybe = self._screen(q, outputs)
+        poses, obstacle_hits, self_hits = outputs
         valid = ~maybe
         for i in np.flatnonzero(maybe):
-            valid[i] = self._free_exact(poses[i], env[i], own[i])
+            valid[i] = self._free_exact(poses[i], obstacle_hits[i], self_hits[i])
         return valid
 
     def is_valid(self, q) -> bool:
@@ -197,17 +162,16 @@ class CollisionChecker:
         if len(q) != 1:
             raise ValueError(f"is_valid takes one configuration of {self.robot.dof} joint values, got shape {q.shape}")
         self.counter.states_checked += 1
-        poses = self.robot.body_poses(q)
         if not self.prefilter:
-            return self._free_reference(poses[0])
-        maybe, env, own = self._candidates(poses)
-        return not maybe[0] or self._free_exact(poses[0], env[0], own[0])
+            return self._free_reference(self.robot.body_poses(q)[0])
+        poses, obstacle_hits, self_hits = self._one
+        return not self._screen(q, self._one)[0] or self._free_exact(poses[0], obstacle_hits[0], self_hits[0])
 
     def first_collision(self, q, order=None, first_chunk: int = 1) -> int:
         """Index of the first configuration in collision, visiting ``q`` (n, dof) in ``order``, or -1.
 
         The first ``first_chunk`` rows of ``order`` (default: row order) go through
-        forward kinematics and the pre-filter together, then the rest together; the exact
+        forward kinematics and the screening together, then the rest together; the exact
         tests run row by row in ``order`` and stop at the first collision. Rows of a chunk
         that was processed count as states checked.
         """
@@ -217,12 +181,15 @@ class CollisionChecker:
             if len(chunk) == 0:
                 continue
             self.counter.states_checked += len(chunk)
-            poses = self.robot.body_poses(q[chunk])
             if not self.prefilter:
+                poses = self.robot.body_poses(q[chunk])
                 hit = next((k for k in range(len(chunk)) if not self._free_reference(poses[k])), -1)
             else:
-                maybe, env, own = self._candidates(poses)
-                hit = next((k for k in np.flatnonzero(maybe) if not self._free_exact(poses[k], env[k], own[k])), -1)
+                outputs = self._screen_outputs(len(chunk))
+                maybe = self._screen(q[chunk], outputs)
+                poses, obstacle_hits, self_hits = outputs
+                hit = next((k for k in np.flatnonzero(maybe)
+                            if not self._free_exact(poses[k], obstacle_hits[k], self_hits[k])), -1)
             if hit >= 0:
                 return int(chunk[hit])
         return -1
@@ -235,33 +202,16 @@ class CollisionChecker:
 
     # ------------------------------------------------------------------ internals
 
-    def _candidates(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Which bounding spheres touch, for body ``poses`` (n, bodies, 4, 4).
+    def _screen_outputs(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Arrays :func:`~ompl_balance.screening.screen` fills for ``n`` configurations:
+        body poses, obstacle-geometry hits and self-pair hits."""
+        return (np.empty((n, self.robot.body_count, 4, 4)),
+                np.empty((n, len(self._obstacles), len(self._links)), dtype=bool),
+                np.empty((n, len(self._pairs)), dtype=bool))
 
-        Returns ``maybe`` (n,) bool, True where a sphere may touch an obstacle's box or a
-        sphere of a self-collision partner; ``env`` (n, obstacles, spheres) and ``own``
-        (n, sphere pairs) bool. Written for small arrays, where each numpy call costs about a
-        microsecond whatever its size: few calls, ``np.take`` rather than fancy indexing,
-        sums of slices rather than reductions along short axes.
-        """
-        n = len(poses)
-        side_by_side = poses[:, :, :3, :].transpose(0, 2, 1, 3).reshape(n, 3, -1)
-        centres = side_by_side @ self._sphere_centre  # (n, 3, spheres)
-        maybe = np.zeros(n, dtype=bool)
-        if len(self._obstacles):
-            height = (self._face_normal @ centres).reshape(n, *self._face_offset.shape) + self._face_offset
-            env = height.max(axis=1) <= 0.0  # (n, obstacles, spheres)
-            maybe |= env.reshape(n, -1).any(axis=1)
-        else:
-            env = np.zeros((n, 0, centres.shape[2]), dtype=bool)
-        if len(self._pairs):
-            gap = np.take(centres, self._pair_sphere_a, axis=2) - np.take(centres, self._pair_sphere_b, axis=2)
-            gap *= gap
-            own = gap[:, 0] + gap[:, 1] + gap[:, 2] <= self._pair_reach
-            maybe |= own.any(axis=1)
-        else:
-            own = np.zeros((n, 0), dtype=bool)
-        return maybe, env, own
+    def _screen(self, q: np.ndarray, outputs) -> np.ndarray:
+        """Screen ``q`` (n, dof) into ``outputs``; True where FCL must decide."""
+        return screen(q, self.robot.chain, self._volumes, *outputs)
 
     def _place(self, body_poses: np.ndarray, geometry: int) -> None:
         """Move the FCL object of ``geometry`` to its pose for one configuration."""
@@ -274,10 +224,11 @@ class CollisionChecker:
     def _collide(self, a: fcl.CollisionObject, b: fcl.CollisionObject) -> bool:
         return fcl.collide(a, b, self._request, fcl.CollisionResult()) > 0
 
-    def _free_exact(self, body_poses: np.ndarray, env: np.ndarray, own: np.ndarray) -> bool:
-        """FCL on the pairs with touching spheres in one configuration; True if none collides.
+    def _free_exact(self, body_poses: np.ndarray, obstacle_hits: np.ndarray, self_hits: np.ndarray) -> bool:
+        """FCL on the pairs the screening did not clear in one configuration; True if none collides.
 
-        ``env`` (obstacles, spheres) and ``own`` (sphere pairs) as from :meth:`_candidates`.
+        ``body_poses`` (bodies, 4, 4), ``obstacle_hits`` (obstacles, geometries) and
+        ``self_hits`` (pairs) as filled by :meth:`_screen`.
         """
         placed = set()
 
@@ -286,17 +237,16 @@ class CollisionChecker:
                 self._place(body_poses, geometry)
                 placed.add(geometry)
 
-        if env.any():
-            for o, g in np.argwhere(np.logical_or.reduceat(env, self._geometry_starts, axis=1)).tolist():
-                place(g)
-                if self._collide(self._links[g], self._obstacles[o]):
-                    return False
-        if own.any():
-            for a, b in self._pairs[np.logical_or.reduceat(own, self._pair_starts)].tolist():
-                place(a)
-                place(b)
-                if self._collide(self._links[a], self._links[b]):
-                    return False
+        for o, g in zip(*np.nonzero(obstacle_hits)):
+            place(g)
+            if self._collide(self._links[g], self._obstacles[o]):
+                return False
+        for p in np.flatnonzero(self_hits):
+            a, b = self._pairs[p]
+            place(a)
+            place(b)
+            if self._collide(self._links[a], self._links[b]):
+                return False
         return True
 
     def _free_reference(self, body_poses: np.ndarray) -> bool:

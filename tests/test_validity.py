@@ -87,6 +87,41 @@ def test_collisions_agree_with_independent_fcl_panda_table_pick():
     check_scene(panda_scene(), 250, seed=2)
 
 
+@needs_data
+def test_certified_free_tables_hold_no_contact_panda():
+    # the forearm (link5) and everything below joint 7 are always close: their pairs get
+    # tables over joints 6 and 7; a free cell must hold no contact anywhere in it, so
+    # probe the free cells next to non-free ones (where a wrong bound would show first)
+    robot, _, _ = panda_scene()
+    volumes = CollisionChecker(robot)._volumes
+    names = [g.link for g in robot.geometries]
+    tabled = {(names[a], names[b]) for (a, b), k in zip(robot.self_collision_pairs, volumes.pair_table) if k >= 0}
+    assert {("panda_link5", "panda_link7"), ("panda_link5", "panda_hand")} <= tabled
+    rng = np.random.default_rng(3)
+    request = fcl.CollisionRequest()
+    for (a, b), k in zip(robot.self_collision_pairs, volumes.pair_table):
+        if k < 0:
+            continue
+        rows, cols = volumes.table_cells[k]
+        free = volumes.table_free[volumes.table_start[k]:volumes.table_start[k] + rows * cols].reshape(rows, cols)
+        assert 0.5 < free.mean() < 1.0  # certifies most, not what it cannot
+        padded = np.pad(free, 1, constant_values=True)
+        border = free & ~(padded[:-2, 1:-1] & padded[2:, 1:-1] & padded[1:-1, :-2] & padded[1:-1, 2:])
+        cells = np.argwhere(border)
+        cells = cells[rng.choice(len(cells), size=min(len(cells), 400), replace=False)]
+        joints = volumes.table_joints[k]
+        values = volumes.table_low[k] + (cells + rng.uniform(size=cells.shape)) * volumes.table_cell[k]
+        q = np.zeros((len(cells), robot.dof))
+        q[:, robot.chain.source[joints]] = values  # the Panda's joints are its active joints
+        poses = robot.body_poses(q)
+        objects = [fcl.CollisionObject(robot.geometries[g].shape.fcl_geometry()) for g in (a, b)]
+        for pose in poses:
+            for obj, g in zip(objects, (a, b)):
+                placed = pose[robot.geometries[g].body] @ robot.geometries[g].origin
+                obj.setTransform(fcl.Transform(placed[:3, :3], placed[:3, 3]))
+            assert not fcl.collide(objects[0], objects[1], request, fcl.CollisionResult()), (names[a], names[b])
+
+
 @pytest.mark.parametrize("count", [1, 3, 8, 32])
 def test_bounding_spheres_cover_every_surface_point(count):
     robot, environment, _ = arm3_scene()
