@@ -325,14 +325,15 @@ class MotionValidator(ob.MotionValidator):
         (if given) is set to the state at ``t``. ``t = 1`` for a valid edge, and whenever
         ``last_valid`` is not given (then the states are visited coarse to fine instead).
         """
-        a, b = np.array(s1[0:self._dof]), np.array(s2[0:self._dof])
-        nd = self._space.validSegmentCount(s1, s2)
         self.checker.counter.motions_checked += 1
+        b = np.array(s2[0:self._dof])
+        if last_valid is None and not self.checker.is_valid(b):
+            # s2 alone on the single-state path first: it decides most colliding edges
+            return False, 1.0
+        a = np.array(s1[0:self._dof])
+        nd = self._space.validSegmentCount(s1, s2)
         t = np.arange(1, nd + 1) / nd
         if last_valid is None:
-            # s2 alone on the single-state path (it decides most colliding edges), then the rest
-            if not self.checker.is_valid(b):
-                return False, 1.0
             states = a + t[:-1, None] * (b - a)
             return nd == 1 or self.checker.first_collision(states, coarse_to_fine(nd)[1:], first_chunk=0) < 0, 1.0
         states = a + t[:, None] * (b - a)
