@@ -120,22 +120,48 @@ class CircleQuery:
 
 
 class Circles2D:
-    """Circular obstacles ``(x, y, r)`` and their bounding box."""
+    """Circular obstacles ``(x, y, r)`` and their bounding box.
+
+    ``no_overlap`` answers as ``Circles2D::noOverlap`` (every circle tested), but tests
+    only the circles whose bounding square meets the point's cell of a
+    :data:`BUCKETS` x :data:`BUCKETS` grid over the bounding box: the same answers for
+    a fraction of the time of a loop over all 70 circles in Python.
+    """
+
+    BUCKETS = 16
 
     def __init__(self, circles: list[tuple[float, float, float]]) -> None:
         if not circles:
             raise ValueError("Circles2D needs at least one circle (x, y, r)")
         self.circles = tuple(circles)
-        # (x, y, r^2) for the validity loop
-        self._squared = tuple((x, y, r * r) for x, y, r in circles)
         self.min_x = min(x - r for x, _, r in circles)
         self.max_x = max(x + r for x, _, r in circles)
         self.min_y = min(y - r for _, y, r in circles)
         self.max_y = max(y + r for _, y, r in circles)
+        self._cell_x = (self.max_x - self.min_x) / self.BUCKETS
+        self._cell_y = (self.max_y - self.min_y) / self.BUCKETS
+        # per cell (row-major, x fastest): (x, y, r^2) of the circles whose square meets it
+        self._buckets: list[list[tuple[float, float, float]]] = [[] for _ in range(self.BUCKETS ** 2)]
+        for x, y, r in circles:
+            for i in range(self._column(x - r), self._column(x + r) + 1):
+                for j in range(self._row(y - r), self._row(y + r) + 1):
+                    self._buckets[j * self.BUCKETS + i].append((x, y, r * r))
+
+    def _column(self, x: float) -> int:
+        return min(max(int((x - self.min_x) / self._cell_x), 0), self.BUCKETS - 1)
+
+    def _row(self, y: float) -> int:
+        return min(max(int((y - self.min_y) / self._cell_y), 0), self.BUCKETS - 1)
+
+    def no_overlap_all(self, x: float, y: float) -> bool:
+        """``Circles2D::noOverlap`` as written: ``(x, y)`` lies in no circle (boundary counts as free)."""
+        return all((cx - x) ** 2 + (cy - y) ** 2 >= r * r for cx, cy, r in self.circles)
 
     def no_overlap(self, x: float, y: float) -> bool:
-        """``Circles2D::noOverlap``: ``(x, y)`` lies in no circle (boundary counts as free)."""
-        for cx, cy, r2 in self._squared:
+        """:meth:`no_overlap_all`, testing only the circles of ``(x, y)``'s cell."""
+        if not (self.min_x <= x <= self.max_x and self.min_y <= y <= self.max_y):
+            return True  # outside the bounding box of all circles
+        for cx, cy, r2 in self._buckets[self._row(y) * self.BUCKETS + self._column(x)]:
             dx = cx - x
             dy = cy - y
             if dx * dx + dy * dy < r2:

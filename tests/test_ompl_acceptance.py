@@ -12,6 +12,7 @@ loaded machine shows in stock's figure as well as ours.
 
 from __future__ import annotations
 
+import math
 import os
 
 import pytest
@@ -89,3 +90,21 @@ def test_termination(entry, env):
 @pytest.mark.parametrize("entry", PLANNERS, ids=lambda entry: entry.label)
 def test_timed(entry, test, outcomes):
     assert_accepted(outcomes, test, entry)
+
+
+def test_circle_buckets_answer_as_every_circle(circles):
+    # the bucketed check is the test's validity checker: it must equal Circles2D::noOverlap
+    import random
+
+    obstacles, _ = circles
+    rng = random.Random(4)
+    points = [(rng.uniform(obstacles.min_x, obstacles.max_x), rng.uniform(obstacles.min_y, obstacles.max_y))
+              for _ in range(20000)]
+    for x, y, r in obstacles.circles:  # on, just inside and just outside every circle
+        for k in range(16):
+            angle = 2 * 3.141592653589793 * k / 16
+            for scale in (1 - 1e-9, 1.0, 1 + 1e-9):
+                points.append((x + scale * r * math.cos(angle), y + scale * r * math.sin(angle)))
+    answers = [obstacles.no_overlap(x, y) for x, y in points]
+    assert answers == [obstacles.no_overlap_all(x, y) for x, y in points]
+    assert 0.1 < 1 - sum(answers) / len(answers) < 0.9  # both answers are exercised
