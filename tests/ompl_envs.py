@@ -161,7 +161,10 @@ class Circles2D:
         """:meth:`no_overlap_all`, testing only the circles of ``(x, y)``'s cell."""
         if not (self.min_x <= x <= self.max_x and self.min_y <= y <= self.max_y):
             return True  # outside the bounding box of all circles
-        for cx, cy, r2 in self._buckets[self._row(y) * self.BUCKETS + self._column(x)]:
+        column = int((x - self.min_x) / self._cell_x)  # (_column and _row, inlined: the hot path)
+        row = int((y - self.min_y) / self._cell_y)
+        last = self.BUCKETS - 1
+        for cx, cy, r2 in self._buckets[(row if row < last else last) * self.BUCKETS + (column if column < last else last)]:
             dx = cx - x
             dy = cy - y
             if dx * dx + dy * dy < r2:
