@@ -24,6 +24,8 @@ import fcl
 import numpy as np
 import trimesh
 
+from .cache import cached_arrays
+
 SHAPE_KINDS = ("box", "sphere", "cylinder", "mesh")
 
 _SPHERES_OF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # Shape -> {count: (centres, radii)}
@@ -123,7 +125,13 @@ class Shape:
             raise ValueError(f"bounding_spheres needs count >= 1, got {count}")
         known = _SPHERES_OF.setdefault(self, {})  # robots share shapes across checkers; compute once
         if count not in known:
-            centres, radii = self._covering_spheres(count)
+            def compute() -> dict[str, np.ndarray]:
+                centres, radii = self._covering_spheres(count)
+                return {"centres": centres, "radii": radii}
+
+            mesh = () if self.mesh is None else (np.asarray(self.mesh.vertices), np.asarray(self.mesh.faces))
+            arrays = cached_arrays("spheres", (self.kind, self.dims, *mesh, count), compute)
+            centres, radii = arrays["centres"], arrays["radii"]
             centres.setflags(write=False)
             radii.setflags(write=False)
             known[count] = centres, radii

@@ -36,6 +36,7 @@ import fcl
 import numpy as np
 from numba import njit
 
+from .cache import cached_arrays
 from .geometry import fcl_transform
 from .kinematics import chain_poses
 
@@ -197,10 +198,18 @@ _TABLES_OF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # robot -> 
 
 
 def _free_tables(robot) -> dict[str, np.ndarray]:
-    """The ``Volumes`` fields of the certified-free tables of ``robot``'s self-collision pairs
-    (computed once per robot: a fraction of a second per table)."""
+    """The ``Volumes`` fields of the certified-free tables of ``robot``'s self-collision pairs.
+
+    A fraction of a second per table: computed once per robot and process, and kept in
+    the disk cache (:mod:`ompl_balance.cache`) under everything they are computed from.
+    """
     if robot not in _TABLES_OF:
-        _TABLES_OF[robot] = _compute_free_tables(robot)
+        key = [*robot.chain, robot.lower, robot.upper, np.array(robot.self_collision_pairs),
+               TABLE_COARSE_CELLS, TABLE_LEVELS, SLACK]
+        for g in robot.geometries:
+            mesh = () if g.shape.mesh is None else (np.asarray(g.shape.mesh.vertices), np.asarray(g.shape.mesh.faces))
+            key += [g.body, g.origin, g.shape.kind, g.shape.dims, *mesh]
+        _TABLES_OF[robot] = cached_arrays("free_tables", key, lambda: _compute_free_tables(robot))
     return _TABLES_OF[robot]
 
 

@@ -1,0 +1,9 @@
+"""Test session settings."""
+
+import os
+import tempfile
+
+# The tests compute what the package caches on disk (covering spheres, certified-free
+# tables) afresh, in a cache of their own, rather than reading a user's cache: a change
+# to those computations must be tested, not served from an earlier version's files.
+os.environ["OMPL_BALANCE_CACHE"] = tempfile.mkdtemp(prefix="ompl_balance_test_cache_")
