@@ -165,7 +165,7 @@ def _child(task: RunTask, connection) -> None:
 
 # "__main__" too: a run's process then need not re-import the main script (spawn semantics)
 _PRELOAD = ["__main__", "ompl_balance.runner"]
-_ROBOT_PRELOAD = ["ompl_balance.mbm", "ompl_balance.robots", "ompl_balance.validity"]
+_ROBOT_PRELOAD = ["ompl_balance.mbm", "ompl_balance.robots", "ompl_balance.validity", "ompl_balance.warm_kernels"]
 
 
 def preload_modules(experiment: Experiment) -> list[str]:

@@ -38,7 +38,7 @@ from numba import njit
 
 from .cache import cached_arrays
 from .geometry import fcl_transform
-from .kinematics import chain_poses
+from .kinematics import Chain, _chain_poses_batch, chain_poses
 
 #: Slack (m) added to every bounding-volume test so that rounding never clears a contact.
 SLACK = 1e-6
@@ -333,3 +333,19 @@ def screen(q, chain, volumes, poses, obstacle_hits, self_hits):  # pragma: no co
                 if self_hits[i, p]:
                     break
     return maybe
+
+
+def warm_up() -> None:
+    """Compile the kernels, or load them from numba's cache, for the argument types every
+    robot's checker uses (a robot with no geometry stands in): about half a second,
+    spent here instead of in a robot's first check. The benchmark runner's forkserver
+    does this once (:mod:`ompl_balance.warm_kernels`), so run processes start warm."""
+    integers, reals = (lambda *shape: np.zeros(shape, dtype=np.int64)), (lambda *shape: np.zeros(shape))
+    chain = Chain(integers(1), reals(1), reals(1), integers(1), reals(1, 3, 3), reals(1, 3, 3), reals(1, 3, 3),
+                  reals(1, 3), reals(1, 3), reals(1, 3))
+    volumes = Volumes(integers(0), reals(0, 3), reals(0), integers(1), reals(0, 3), reals(0), reals(0, 3),
+                      reals(0, 3, 3), reals(0, 3), integers(0, 2), integers(0), integers(0, 2), reals(0, 2),
+                      reals(0, 2), integers(0, 2), integers(0), np.zeros(0, dtype=bool))
+    q, poses = reals(1, 1), reals(1, 2, 4, 4)
+    screen(q, chain, volumes, poses, np.zeros((1, 0, 0), dtype=bool), np.zeros((1, 0), dtype=bool))
+    _chain_poses_batch(q, chain, poses)

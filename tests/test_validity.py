@@ -249,3 +249,20 @@ def test_bad_input():
     with pytest.raises(ValueError, match="positive"):
         environment.add_sphere("flat", 0.0)
     assert isinstance(MotionValidator(si, checker), ob.MotionValidator)
+
+
+def test_warm_up_compiles_the_kernels_real_checkers_use():
+    # the runner's forkserver warms the kernels with stand-in arrays: their types must be the
+    # ones real robots pass, or each run would compile (or load) the kernels again; so the
+    # process never holds more than one compiled version of each, whatever ran before
+    from ompl_balance.kinematics import _chain_poses_batch
+    from ompl_balance.screening import screen, warm_up
+
+    warm_up()
+    robot, environment, _ = arm3_scene()
+    checker = CollisionChecker(robot, environment)
+    q = np.zeros((2, robot.dof))
+    checker.check(q)
+    checker.is_valid(q[0])
+    robot.body_poses(q)
+    assert len(screen.signatures) == 1 and len(_chain_poses_batch.signatures) == 1
