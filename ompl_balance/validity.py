@@ -23,9 +23,11 @@ OMPL's interfaces; they share its :class:`WorkCounter` (see :mod:`ompl_balance.c
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import fcl
+import numba
 import numpy as np
 import trimesh
 from ompl import base as ob
@@ -136,9 +138,14 @@ class CollisionChecker:
         self._environment_manager.setup()
 
         self._volumes = build_volumes(robot, obstacles, spheres_per_geometry)
-        # the single-state path (OMPL's isValid) reuses its output arrays
+        # The screening kernel is called without numba's type dispatch (about 4 us of a
+        # 30 us state check): the argument types are fixed here, and _screen passes
+        # C-contiguous float rows and fresh output arrays. The single-state path (OMPL's
+        # isValid) reuses its output arrays.
         self._one = self._screen_outputs(1)
-        self._screen(np.zeros((1, robot.dof)), self._one)  # compile or load the kernel now, not in a solve
+        arguments = (np.zeros((1, robot.dof)), robot.chain, self._volumes, *self._one)
+        screen(*arguments)  # compile or load the kernel now, not in a solve
+        self._kernel = screen.overloads[tuple(numba.typeof(a) for a in arguments)].entry_point
 
     # ------------------------------------------------------------------ public API
 
@@ -210,8 +217,8 @@ class CollisionChecker:
                 np.empty((n, len(self._pairs)), dtype=bool))
 
     def _screen(self, q: np.ndarray, outputs) -> np.ndarray:
-        """Screen ``q`` (n, dof) into ``outputs``; True where FCL must decide."""
-        return screen(q, self.robot.chain, self._volumes, *outputs)
+        """Screen ``q`` (n, dof) into ``outputs`` (from :meth:`_screen_outputs`); True where FCL must decide."""
+        return self._kernel(np.ascontiguousarray(q), self.robot.chain, self._volumes, *outputs)
 
     def _place(self, body_poses: np.ndarray, geometry: int) -> None:
         """Move the FCL object of ``geometry`` to its pose for one configuration."""
@@ -352,11 +359,13 @@ class MotionValidator(ob.MotionValidator):
         self.checker.reset_counters()
 
 
-def coarse_to_fine(nd: int) -> list[int]:
+@functools.lru_cache(maxsize=4096)
+def coarse_to_fine(nd: int) -> tuple[int, ...]:
     """Visiting order of the states ``j / nd``, ``j = 1 .. nd`` (as indices ``j - 1``).
 
     The end state first, then breadth-first bisection of ``(0, nd)``: the midpoint, the
-    quarter points, and so on, so that an obstacle across the edge is met early.
+    quarter points, and so on, so that an obstacle across the edge is met early. Cached:
+    planners ask for the same few lengths again and again.
     """
     order = [nd - 1]
     intervals = [(0, nd)]
@@ -367,7 +376,7 @@ def coarse_to_fine(nd: int) -> list[int]:
         mid = (low + high) // 2
         order.append(mid - 1)
         intervals += [(low, mid), (mid, high)]
-    return order
+    return tuple(order)
 
 
 def setup_robot(ss_or_si, checker: CollisionChecker) -> tuple[StateValidityChecker, MotionValidator]:

@@ -202,7 +202,7 @@ def test_coarse_to_fine_visits_every_state_once():
     for nd in range(1, 40):
         order = coarse_to_fine(nd)
         assert sorted(order) == list(range(nd)) and order[0] == nd - 1
-    assert coarse_to_fine(8)[:4] == [7, 3, 1, 5]
+    assert coarse_to_fine(8)[:4] == (7, 3, 1, 5)
 
 
 def test_space_bounds_and_planning_with_rrtconnect():
