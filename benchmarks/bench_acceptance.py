@@ -1,9 +1,9 @@
 """OMPL's planner acceptance test (2denvs.cpp) for every package planner, next to stock.
 
 Runs the harness of ``tests/acceptance.py`` (the port of OMPL's
-``tests/geometric/2d/2denvs.cpp``) for stock ``og.RRTConnect`` and every planner the
-package exports, interleaved run by run in one process, and prints a markdown table:
-per planner and test, success rate, average time per run/query (solve + simplify, OMPL's
+``tests/geometric/2d/2denvs.cpp``) for stock ``og.RRTConnect``, stock ``og.RRTstar`` (the
+control for the package's RRT*) and every planner the package exports, interleaved run
+by run in one process, and prints a markdown table: per planner and test, success rate, average time per run/query (solve + simplify, OMPL's
 average), average path length, the time ratio to stock from the same run, and whether
 OMPL's thresholds (>= 95 %, < 2 x 0.01 s x MACHINE_SPEED_FACTOR, length < 100) are met.
 
@@ -31,6 +31,7 @@ from acceptance import (  # noqa: E402 (the harness lives with the tests)
     MACHINE_SPEED_FACTOR,
     MAP_RUNS,
     STOCK,
+    STOCK_RRT_STAR,
     Outcome,
     package_planners,
     run_2d_circles_test,
@@ -117,7 +118,7 @@ def main() -> None:
     env = load_environment(RESOURCES / "env1.txt")
     circles = load_circles(RESOURCES / "circle_obstacles.txt")
     queries = load_queries(RESOURCES / "circle_queries.txt")[: args.queries]
-    entries = [STOCK, *package_planners()]
+    entries = [STOCK, STOCK_RRT_STAR, *package_planners()]
 
     load_before = os.getloadavg()
     began = time.perf_counter()
