@@ -127,7 +127,6 @@ class CollisionChecker:
         geometries, obstacles = robot.geometries, self.environment.obstacles
         self._request = fcl.CollisionRequest()
 
-        self._geometry_body = np.array([g.body for g in geometries], dtype=int)
         self._geometry_origin = np.array([g.origin for g in geometries]).reshape(-1, 4, 4)
         self._origin_is_identity = [bool(np.array_equal(g.origin, np.eye(4))) for g in geometries]
         self._links = [fcl.CollisionObject(g.shape.fcl_geometry(), fcl.Transform()) for g in geometries]
@@ -222,7 +221,7 @@ class CollisionChecker:
 
     def _place(self, body_poses: np.ndarray, geometry: int) -> None:
         """Move the FCL object of ``geometry`` to its pose for one configuration."""
-        pose = body_poses[self._geometry_body[geometry]]
+        pose = body_poses[self._volumes.geometry_body[geometry]]
         if not self._origin_is_identity[geometry]:
             pose = pose.dot(self._geometry_origin[geometry])
         self._links[geometry].setRotation(pose[:3, :3])
