@@ -88,20 +88,20 @@ def chain_poses(q, chain, poses):  # pragma: no cover (compiled)
     for k in range(len(chain.source)):
         value = chain.multiplier[k] * q[chain.source[k]] + chain.shift[k]
         sin, cos = np.sin(value), np.cos(value)
-        parent = poses[chain.parent_body[k]]
+        parent = poses[chain.parent_body[k]]  # an earlier body: never the one written here
         body = poses[k + 1]
-        for row in range(3):
+        body[:3, :3] = 0.0
+        body[:3, 3] = parent[:3, 3]
+        # body = parent @ local, each entry of the joint's local transform computed once
+        for m in range(3):
             for col in range(3):
-                entry = 0.0
-                for m in range(3):
-                    local = (chain.rotation_fixed[k, m, col] + sin * chain.rotation_sin[k, m, col]
-                             - cos * chain.rotation_cos[k, m, col])
-                    entry += parent[row, m] * local
-                body[row, col] = entry
-            entry = parent[row, 3]
-            for m in range(3):
-                entry += parent[row, m] * (chain.translation[k, m] + value * chain.slide[k, m])
-            body[row, 3] = entry
+                local = (chain.rotation_fixed[k, m, col] + sin * chain.rotation_sin[k, m, col]
+                         - cos * chain.rotation_cos[k, m, col])
+                for row in range(3):
+                    body[row, col] += parent[row, m] * local
+            local = chain.translation[k, m] + value * chain.slide[k, m]
+            for row in range(3):
+                body[row, 3] += parent[row, m] * local
         body[3, 0], body[3, 1], body[3, 2], body[3, 3] = 0.0, 0.0, 0.0, 1.0
 
 

@@ -37,6 +37,7 @@ from .geometry import Shape, fcl_transform, pose_matrix
 from .kinematics import RobotModel
 from .screening import build_volumes, screen
 
+
 @dataclass(frozen=True, eq=False)
 class Obstacle:
     """A static obstacle: ``shape`` at world ``pose`` (4, 4)."""
@@ -131,7 +132,7 @@ class CollisionChecker:
         self._origin_is_identity = [bool(np.array_equal(g.origin, np.eye(4))) for g in geometries]
         self._links = [fcl.CollisionObject(g.shape.fcl_geometry(), fcl.Transform()) for g in geometries]
         self._obstacles = [fcl.CollisionObject(o.shape.fcl_geometry(), fcl_transform(o.pose)) for o in obstacles]
-        self._pairs = [tuple(pair) for pair in robot.self_collision_pairs]
+        self._pairs = robot.self_collision_pairs  # (a, b) geometry indices
         self._environment_manager = fcl.DynamicAABBTreeCollisionManager()
         self._environment_manager.registerObjects(self._obstacles)
         self._environment_manager.setup()
