@@ -71,8 +71,6 @@ def results_table(map_outcomes: list[Outcome], circles_outcomes: list[Outcome]) 
         faults = len(on_map.faulty_paths) + len(on_circles.faulty_paths)
         if faults:
             unmet.append(f"{faults} paths fail the re-check")
-        if on_circles.thresholds.known_slow and unmet:
-            unmet.append(f"known: {on_circles.thresholds.known_slow}")
         lines.append(
             f"| {on_map.planner} | {on_map.success:.0f} % | {_ms(on_map.avg_time)} | {on_map.avg_length:.1f} "
             f"| {on_circles.success:.0f} % | {_ms(on_circles.avg_time)} = {_ms(on_circles.solve_time / on_circles.runs)}"

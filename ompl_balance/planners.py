@@ -41,7 +41,7 @@ from .counting import ensure_counting, read_work
 from .gamma import estimate_ball_radius_constant, rewire_radius
 from .params import ParamSet
 from .samplers import PassageSampler
-from .spaces import RealVectorPoints, StatePoints, points_for
+from .spaces import RealVectorPoints, StatePoints, points_for, prepare
 from .trees import NO_PARENT
 
 #: OMPL's default range as a fraction of the space's maximum extent
@@ -526,6 +526,7 @@ class BalancedRRTConnect(ob.Planner):
         super().setup()
         si = self.getSpaceInformation()
         ensure_counting(si)
+        prepare(si)
         if self._range < 1e-12:
             self._range = RANGE_AS_EXTENT_FRACTION * si.getMaximumExtent()
             ou.OMPL_INFORM(f"{self.getName()}: range computed to be {self._range:g}")
@@ -1155,6 +1156,7 @@ class BallRadiusRRTstar(ob.Planner):
         super().setup()
         si = self.getSpaceInformation()
         ensure_counting(si)
+        prepare(si)
         if self._max_connection_distance < 1e-12:
             self._max_connection_distance = RANGE_AS_EXTENT_FRACTION * si.getMaximumExtent()
             ou.OMPL_INFORM(f"{self.getName()}: max_connection_distance computed to be {self._max_connection_distance:g}")
@@ -1260,39 +1262,40 @@ class BallRadiusRRTstar(ob.Planner):
                 continue  # the sample is a tree node already
             near_point = tree.state(nearest)
             new = target if distance <= eta else points.interpolate(near_point, target, eta / distance)
-            if not check_motion(ompl_state(near_point, 0), ompl_state(new, 1)):
+            new_state = ompl_state(new, 1)  # written once: every check below uses it
+            if not check_motion(ompl_state(near_point, 0), new_state):
                 continue
 
             # Parent: the neighbour giving the cheapest valid path, checked in order of cost.
             neighbours, distances = tree.near(new, rewire_radius(len(tree) + 1, d, gamma, eta))
             costs = self._costs
-            parent, cost = nearest, costs[nearest] + min(distance, eta)
             through = costs[neighbours] + distances
-            valid = np.zeros(len(neighbours), dtype=np.int8)  # motion to the new state: 1 valid, -1 not, 0 unchecked
-            valid[neighbours == nearest] = 1
-            for i in np.argsort(through):
+            parent, cost = nearest, costs[nearest] + min(distance, eta)
+            valid = {nearest: True}  # neighbour -> whether its motion to the new state is valid
+            for i in through.argsort().tolist():
                 if through[i] >= cost:
                     break
-                if check_motion(ompl_state(tree.state(neighbours[i]), 0), ompl_state(new, 1)):
-                    parent, cost, valid[i] = int(neighbours[i]), through[i], 1
+                neighbour = int(neighbours[i])
+                valid[neighbour] = check_motion(ompl_state(tree.state(neighbour), 0), new_state)
+                if valid[neighbour]:
+                    parent, cost = neighbour, float(through[i])
                     break
-                valid[i] = -1
             added = self._add_node(new, parent, cost)
-            found_goal = is_goal(ompl_state(tree.state(added), 1))
+            found_goal = is_goal(new_state)
             if found_goal:
                 self._goal_nodes.append(added)
 
             # Rewire: neighbours reached more cheaply through the new state.
             costs = self._costs
             rewired = False
-            for i in np.flatnonzero(cost + distances < costs[neighbours]):
-                neighbour = int(neighbours[i])
-                if not cost + distances[i] < costs[neighbour]:
+            for i in np.flatnonzero(cost + distances < costs[neighbours]).tolist():
+                neighbour, through_new = int(neighbours[i]), cost + distances[i]
+                if not through_new < costs[neighbour]:
                     continue  # an earlier rewire in this loop made it cheaper already
-                if valid[i] == 0:
-                    valid[i] = 1 if check_motion(ompl_state(tree.state(added), 0), ompl_state(tree.state(neighbour), 1)) else -1
-                if valid[i] == 1:
-                    self._rewire(neighbour, added, cost + distances[i])
+                if neighbour not in valid:
+                    valid[neighbour] = check_motion(new_state, ompl_state(tree.state(neighbour), 0))
+                if valid[neighbour]:
+                    self._rewire(neighbour, added, through_new)
                     rewires += 1
                     rewired = True
 

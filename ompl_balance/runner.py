@@ -164,7 +164,7 @@ def _child(task: RunTask, connection) -> None:
 # -- around the run's process -----------------------------------------------------------
 
 # "__main__" too: a run's process then need not re-import the main script (spawn semantics)
-_PRELOAD = ["__main__", "ompl_balance.runner"]
+_PRELOAD = ["__main__", "ompl_balance.runner", "ompl_balance.scans"]
 _ROBOT_PRELOAD = ["ompl_balance.mbm", "ompl_balance.robots", "ompl_balance.validity", "ompl_balance.warm_kernels"]
 
 

@@ -25,7 +25,7 @@ import math
 import numpy as np
 from ompl import base as ob
 
-from .trees import ArrayTree, StateTree
+from .trees import ArrayTree, StateTree, load_scans
 
 _SAMPLE_BLOCK = 256  # uniform samples drawn from numpy at a time
 _EQUAL_TOLERANCE = 2.0 * float(np.finfo(float).eps)
@@ -170,8 +170,17 @@ class StatePoints:
         return [self.interpolate(a, b, step / count) for step in range(1, count)] + [self.new_state(b)]
 
 
+def _is_real_vector(si: ob.SpaceInformation) -> bool:
+    return type(si.getStateSpace()) is ob.RealVectorStateSpace
+
+
 def points_for(si: ob.SpaceInformation, rng: np.random.Generator) -> RealVectorPoints | StatePoints:
     """The fast array view for plain real-vector spaces, OMPL states otherwise."""
-    if type(si.getStateSpace()) is ob.RealVectorStateSpace:
-        return RealVectorPoints(si, rng)
-    return StatePoints(si)
+    return RealVectorPoints(si, rng) if _is_real_vector(si) else StatePoints(si)
+
+
+def prepare(si: ob.SpaceInformation) -> None:
+    """One-time work a planner's ``setup()`` does so that ``solve()`` does not: for
+    real-vector spaces, load the compiled tree scans (:func:`~ompl_balance.trees.load_scans`)."""
+    if _is_real_vector(si):
+        load_scans()

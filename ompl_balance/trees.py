@@ -4,7 +4,7 @@ Two stores with one interface, chosen by :mod:`ompl_balance.spaces`:
 
 :class:`ArrayTree`
     real-vector states in one contiguous ``(capacity, dim)`` float64 array grown by
-    doubling; nearest neighbour by one vectorised distance computation (exact).
+    doubling; nearest and near neighbours by one compiled scan of all nodes (exact).
 :class:`StateTree`
     OMPL states of any space in a list; nearest neighbour by ``si.distance`` over all
     nodes (exact, slower: one call into OMPL per node).
@@ -66,30 +66,36 @@ class _Links:
         self.parents[subtree[0]] = parent
         self.roots[subtree] = self.roots[parent]
 
-    def near(self, state, radius: float) -> tuple[np.ndarray, np.ndarray]:
-        """Indices of the nodes within ``radius`` of ``state`` (exact) and their distances."""
-        distances = self.distances(state)
-        within = np.flatnonzero(distances <= radius)
-        return within, distances[within]
-
     def clear(self) -> None:
         self.size = 0
 
 
-_EPS = float(np.finfo(float).eps)
-_BRUTE_FORCE_SIZE = 256  # below this, plain squared distances beat the matrix-vector ranking
+def load_scans():
+    """The compiled nearest/near scans (:mod:`ompl_balance.scans`).
+
+    The first call imports numba and loads the kernels (about half a second, once per
+    process); planners call it from ``setup()`` so that no solve pays it.
+    """
+    from . import scans
+
+    return scans
 
 
 class ArrayTree(_Links):
-    """Real-vector states of one tree, shape ``(len(tree), dim)``."""
+    """Real-vector states of one tree, shape ``(len(tree), dim)``.
+
+    Nearest and near queries scan all nodes in one compiled loop (exact, and for the
+    tree sizes sampling planners reach, faster than any index would be from Python).
+    """
 
     def __init__(self, dim: int, capacity: int = 1024) -> None:
         super().__init__(capacity)
+        scans = load_scans()
+        self._nearest, self._within = scans.nearest, scans.within
         self._states = np.empty((capacity, dim))
-        # |state|^2 per node for nearest() on large trees, filled in batches when needed
-        self._squared_norms = np.empty(capacity)
-        self._normed = 0  # nodes whose squared norm is filled in
-        self._largest_norm = 0.0
+        # scratch output of near(), one slot per node
+        self._near_indices = np.empty(capacity, dtype=np.int64)
+        self._near_distances = np.empty(capacity)
 
     @property
     def states(self) -> np.ndarray:
@@ -104,44 +110,22 @@ class ArrayTree(_Links):
         index = self._link(parent)
         if index == len(self._states):
             self._states = np.concatenate([self._states, np.empty_like(self._states)])
-            self._squared_norms = np.concatenate([self._squared_norms, np.empty_like(self._squared_norms)])
+            self._near_indices = np.empty(len(self._states), dtype=np.int64)
+            self._near_distances = np.empty(len(self._states))
         self._states[index] = state
         return index
 
     def nearest(self, state: np.ndarray) -> tuple[int, float]:
-        """Index of the node closest to ``state`` (Euclidean) and its distance (exact).
+        """Index of the node closest to ``state`` (Euclidean; the first on ties) and its distance."""
+        if self.size == 0:
+            raise ValueError("nearest() of an empty tree: add a root first")
+        index, squared = self._nearest(self._states, self.size, state)
+        return index, math.sqrt(squared)
 
-        Small trees: squared distances of all nodes. Larger trees: nodes ranked by
-        ``|s|^2 - 2 s.q`` (one matrix-vector product, fewer temporaries), with
-        near-ties within that expansion's rounding error settled by exact distances.
-        """
-        states = self._states[: self.size]
-        if self.size <= _BRUTE_FORCE_SIZE:
-            offsets = states - state
-            squared = np.einsum("ij,ij->i", offsets, offsets)
-            index = int(squared.argmin())
-            return index, math.sqrt(squared[index])
-        if self._normed < self.size:  # norms of the nodes added since the last large-tree query
-            fresh = states[self._normed :]
-            norms = np.einsum("ij,ij->i", fresh, fresh)
-            self._squared_norms[self._normed : self.size] = norms
-            self._largest_norm = max(self._largest_norm, math.sqrt(float(norms.max())))
-            self._normed = self.size
-        scores = self._squared_norms[: self.size] - 2.0 * (states @ state)
-        index = int(scores.argmin())
-        reach = self._largest_norm + math.sqrt(float(state @ state))
-        near_ties = scores <= scores[index] + 16.0 * len(state) * _EPS * reach * reach
-        if np.count_nonzero(near_ties) > 1:
-            ties = near_ties.nonzero()[0]
-            offsets = states[ties] - state
-            index = int(ties[np.einsum("ij,ij->i", offsets, offsets).argmin()])
-        offset = states[index] - state
-        return index, math.sqrt(float(offset @ offset))
-
-    def clear(self) -> None:
-        super().clear()
-        self._normed = 0
-        self._largest_norm = 0.0
+    def near(self, state: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
+        """Indices of the nodes within ``radius`` of ``state`` (exact, ascending) and their distances."""
+        count = self._within(self._states, self.size, state, radius, self._near_indices, self._near_distances)
+        return self._near_indices[:count].copy(), self._near_distances[:count].copy()
 
     def distances(self, state: np.ndarray) -> np.ndarray:
         """Euclidean distance from every node to ``state``, ``(len(tree),)``."""
@@ -183,6 +167,12 @@ class StateTree(_Links):
         """``si.distance`` from every node to ``state``, ``(len(tree),)``."""
         distance = self._distance
         return np.array([distance(node, state) for node in self._states], dtype=float)
+
+    def near(self, state: ob.State, radius: float) -> tuple[np.ndarray, np.ndarray]:
+        """Indices of the nodes within ``radius`` of ``state`` (exact, ascending) and their distances."""
+        distances = self.distances(state)
+        within = np.flatnonzero(distances <= radius)
+        return within, distances[within]
 
     def clear(self) -> None:
         super().clear()

@@ -67,10 +67,6 @@ class Thresholds:
 
     min_success: float  # percent of runs solved
     max_avg_time: float  # s, before MACHINE_SPEED_FACTOR
-    # Why this planner is known to miss the time bound today ("" = none). The time is
-    # still measured and checked; the test reports a miss as an expected failure with
-    # the figures, success and length stay hard requirements (README lists the misses).
-    known_slow: str = ""
 
     @property
     def time_bound(self) -> float:
@@ -79,16 +75,6 @@ class Thresholds:
 
 
 RRT_CONNECT_THRESHOLDS = Thresholds(95.0, 0.01)  # OMPL_PLANNER_TEST(RRTConnect, 95.0, 0.01)
-
-#: Planners known to miss RRT-Connect's time bound from Python today, and why.
-KNOWN_SLOW = {
-    "BallRadiusRRTstar": Thresholds(
-        95.0, 0.01, known_slow="RRT*: parent choice and rewiring check 4-7x RRT-Connect's states through OMPL's "
-        "motion validator and the Python checker (OMPL's C++ RRT* takes ~48 ms through this harness), plus ~50 us "
-        "of Python per iteration; 2denvs.cpp does not test RRT*"
-    ),
-}
-
 
 @dataclass(frozen=True)
 class PlannerEntry:
@@ -121,8 +107,7 @@ def configured(planner_class: type, balance_tree_sizes: bool | None = None) -> P
 STOCK = PlannerEntry("RRTConnect (stock)", configured(og.RRTConnect))
 #: OMPL's own RRT* through the same harness: the control for ``BallRadiusRRTstar``
 #: (``benchmarks/bench_acceptance.py`` reports it; the tests do not assert on it).
-STOCK_RRT_STAR = PlannerEntry("RRTstar (stock)", configured(og.RRTstar), Thresholds(
-    95.0, 0.01, known_slow="control: OMPL's C++ RRT*, whose parent choice and rewiring check many states too"))
+STOCK_RRT_STAR = PlannerEntry("RRTstar (stock)", configured(og.RRTstar))
 
 
 def package_planners() -> list[PlannerEntry]:
@@ -130,8 +115,9 @@ def package_planners() -> list[PlannerEntry]:
 
     ``BalancedRRTConnect`` with balancing on and off; each class of the ``PRESETS``
     dict (name -> class) when the module has one; ``BallRadiusRRTstar`` when it exists,
-    under RRT's thresholds (2denvs.cpp tests no RRT*; stopped at its first solution by
-    the infinite cost threshold, it is an RRT). Planners added later join automatically.
+    all under RRT-Connect's thresholds (2denvs.cpp tests no RRT*, and gives RRT the same
+    numbers; stopped at its first solution by the infinite cost threshold, RRT* is an RRT
+    that rewires). Planners added later join automatically.
     """
     entries = [
         PlannerEntry("BalancedRRTConnect", configured(BalancedRRTConnect, balance_tree_sizes=True)),
@@ -139,10 +125,10 @@ def package_planners() -> list[PlannerEntry]:
     ]
     for name, planner_class in getattr(package_planners_module, "PRESETS", {}).items():
         if planner_class is not BalancedRRTConnect:  # listed above, balancing on and off
-            entries.append(PlannerEntry(name, configured(planner_class), KNOWN_SLOW.get(name, RRT_CONNECT_THRESHOLDS)))
+            entries.append(PlannerEntry(name, configured(planner_class)))
     rrt_star = getattr(package_planners_module, "BallRadiusRRTstar", None)
     if rrt_star is not None:
-        entries.append(PlannerEntry("BallRadiusRRTstar", configured(rrt_star), KNOWN_SLOW["BallRadiusRRTstar"]))
+        entries.append(PlannerEntry("BallRadiusRRTstar", configured(rrt_star)))
     return entries
 
 
@@ -195,9 +181,6 @@ class Outcome:
     @property
     def avg_length(self) -> float:
         return self.length / self.runs
-
-    def time_met(self) -> bool:
-        return self.avg_time < self.thresholds.time_bound
 
     def unmet(self) -> list[str]:
         """OMPL's three checks that fail, as readable sentences (empty when accepted)."""

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from ompl import base as ob
 
+from fresh_process import run_with_seed
 from ompl_balance.trees import NO_PARENT, ArrayTree, StateTree
 
 
@@ -22,6 +23,51 @@ def test_array_tree_nearest_is_exact(dim, offset, scale):
             index, distance = tree.nearest(query)
             assert distances[index] == distances.min()
             assert distance == pytest.approx(distances.min(), rel=1e-12, abs=0)
+
+
+@pytest.mark.parametrize("dim", [2, 7])
+def test_array_tree_near_is_exact(dim):
+    """Every node within the radius, in index order, with its distance; none outside it."""
+    rng = np.random.default_rng(dim)
+    tree = ArrayTree(dim, capacity=4)
+    points = rng.random((700, dim))
+    for point in points:
+        tree.add(point, NO_PARENT)
+    for query in rng.random((50, dim)):
+        distances = np.linalg.norm(points - query, axis=1)
+        radius = float(np.quantile(distances, 0.05))
+        indices, near_distances = tree.near(query, radius)
+        assert indices.tolist() == np.flatnonzero(distances <= radius).tolist()
+        assert near_distances == pytest.approx(distances[indices], rel=1e-12, abs=0)
+    # a strided query (a column of a matrix) answers as a contiguous one
+    column = np.asfortranarray(rng.random((dim, 3)))[:, 1]
+    assert tree.nearest(column) == tree.nearest(np.ascontiguousarray(column))
+
+
+def test_array_tree_nearest_of_an_empty_tree_is_refused():
+    with pytest.raises(ValueError, match="empty tree"):
+        ArrayTree(2).nearest(np.zeros(2))
+
+
+def test_import_stays_quick():
+    """``import ompl_balance`` loads neither numba nor the compiled scans; a planner's setup() does."""
+    script = (
+        "import sys\n"
+        "import ompl_balance\n"
+        "from ompl import base as ob, util as ou\n"
+        "ou.setLogLevel(ou.LOG_WARN)\n"
+        "print('numba' in sys.modules, 'ompl_balance.scans' in sys.modules)\n"
+        "space = ob.RealVectorStateSpace(2)\n"
+        "space.setBounds(0.0, 1.0)\n"
+        "si = ob.SpaceInformation(space)\n"
+        "si.setStateValidityChecker(lambda state: True)\n"
+        "si.setup()\n"
+        "planner = ompl_balance.BalancedRRTConnect(si)\n"
+        "planner.setProblemDefinition(ob.ProblemDefinition(si))\n"
+        "planner.setup()\n"
+        "print('ompl_balance.scans' in sys.modules)\n"
+    )
+    assert run_with_seed(script, 0).split() == ["False", "False", "True"]
 
 
 def test_links_roots_and_branches():

@@ -1,0 +1,46 @@
+"""Compiled scans over a tree's states: the nearest node, and the nodes within a radius.
+
+Both read the rows ``states[:size]`` of a C-contiguous ``(capacity, dim)`` float64
+array (:class:`~ompl_balance.trees.ArrayTree`'s storage) and compare squared
+Euclidean distances exactly, one row at a time. Compiled with numba for one fixed
+signature, so a process compiles (or loads from numba's cache) each kernel once, at
+import; importing this module therefore takes about half a second the first time in
+a process, which is why :mod:`ompl_balance.trees` imports it on first use.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit("Tuple((int64, float64))(float64[:, ::1], int64, float64[:])", cache=True)
+def nearest(states, size, query):  # pragma: no cover (compiled)
+    """Index of the row of ``states[:size]`` closest to ``query`` and its squared distance."""
+    best, best_squared = 0, np.inf
+    for i in range(size):
+        squared = 0.0
+        for k in range(query.shape[0]):
+            offset = states[i, k] - query[k]
+            squared += offset * offset
+        if squared < best_squared:
+            best, best_squared = i, squared
+    return best, best_squared
+
+
+@njit("int64(float64[:, ::1], int64, float64[:], float64, int64[::1], float64[::1])", cache=True)
+def within(states, size, query, radius, indices, distances):  # pragma: no cover (compiled)
+    """Rows of ``states[:size]`` within ``radius`` of ``query``, written to ``indices`` and
+    ``distances`` in index order; returns how many."""
+    count = 0
+    limit = radius * radius
+    for i in range(size):
+        squared = 0.0
+        for k in range(query.shape[0]):
+            offset = states[i, k] - query[k]
+            squared += offset * offset
+        if squared <= limit:
+            indices[count] = i
+            distances[count] = math.sqrt(squared)
+            count += 1
+    return count
