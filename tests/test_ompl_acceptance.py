@@ -5,9 +5,10 @@ Each planner the package exports (found at import time, see
 through the same harness: the simple test, the termination test, the 2-D map test and
 the 2-D circles test at OMPL's thresholds, with OMPL's counts (100 map runs, the 100
 circles queries; about half a minute for a dozen planners). The timed tests print
-OMPL's figures and stock's from the same run in their assertion messages, with the load average: the time bound is absolute, as in OMPL (set
-``MACHINE_SPEED_FACTOR``, default 3, as OMPL's CMake option, 5 in OMPL's CI), and a
-loaded machine shows in stock's figure as well as ours.
+OMPL's figures and stock's from the same run in their assertion messages, with the
+load average: the time bound is absolute, as in OMPL (set ``MACHINE_SPEED_FACTOR``,
+default 3, as OMPL's CMake option, 5 in OMPL's CI), and a loaded machine shows in
+stock's figure as well as ours.
 """
 
 from __future__ import annotations
