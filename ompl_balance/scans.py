@@ -14,15 +14,21 @@ import numpy as np
 from numba import njit
 
 
+@njit(cache=True, inline="always")
+def _squared_distance(states, row, query):  # pragma: no cover (compiled)
+    squared = 0.0
+    for k in range(query.shape[0]):
+        offset = states[row, k] - query[k]
+        squared += offset * offset
+    return squared
+
+
 @njit("Tuple((int64, float64))(float64[:, ::1], int64, float64[:])", cache=True)
 def nearest(states, size, query):  # pragma: no cover (compiled)
     """Index of the row of ``states[:size]`` closest to ``query`` and its squared distance."""
     best, best_squared = 0, np.inf
     for i in range(size):
-        squared = 0.0
-        for k in range(query.shape[0]):
-            offset = states[i, k] - query[k]
-            squared += offset * offset
+        squared = _squared_distance(states, i, query)
         if squared < best_squared:
             best, best_squared = i, squared
     return best, best_squared
@@ -35,10 +41,7 @@ def within(states, size, query, radius, indices, distances):  # pragma: no cover
     count = 0
     limit = radius * radius
     for i in range(size):
-        squared = 0.0
-        for k in range(query.shape[0]):
-            offset = states[i, k] - query[k]
-            squared += offset * offset
+        squared = _squared_distance(states, i, query)
         if squared <= limit:
             indices[count] = i
             distances[count] = math.sqrt(squared)
