@@ -10,11 +10,11 @@ from ompl_balance.trees import NO_PARENT, ArrayTree, StateTree
 
 @pytest.mark.parametrize(("dim", "offset", "scale"), [(2, 0.0, 1.0), (7, 0.0, 1.0), (3, 1e6, 1e-3), (7, -50.0, 1e-6)])
 def test_array_tree_nearest_is_exact(dim, offset, scale):
-    """Brute-force comparison, including clouds far from the origin where |s|^2 - 2 s.q cancels."""
+    """Brute-force comparison, including clouds far from the origin and tiny spreads."""
     rng = np.random.default_rng(dim)
     tree = ArrayTree(dim, capacity=4)  # grows by doubling several times
     points = offset + scale * rng.random((600, dim))
-    for size in (100, 600):  # below and above the brute-force size
+    for size in (100, 600):  # a small tree, then one grown past its capacity several times
         while tree.size < size:
             tree.add(points[tree.size], NO_PARENT if tree.size == 0 else 0)
         assert np.array_equal(tree.states, points[:size])
