@@ -24,9 +24,9 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect
-from ompl_balance.counting import measured_solve
-from ompl_balance.mbm import load_mbm
-from ompl_balance.robots import load_panda_vamp
+from ompl_balance.core.counting import measured_solve
+from ompl_balance.worlds.mbm import load_mbm
+from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.validity import CollisionChecker
 
 SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small")

@@ -28,8 +28,8 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect, CountingValidityChecker
-from ompl_balance.counting import measured_solve
-from ompl_balance.problems import get_problem
+from ompl_balance.core.counting import measured_solve
+from ompl_balance.worlds.boxes import get_problem
 
 DIM = 7
 CHECK_COST_NS = 20_000

@@ -27,9 +27,9 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ompl_balance.counting import read_work
+from ompl_balance.core.counting import read_work
 from ompl_balance.gamma import ball_radius_constant, ompl_rewire_factor
-from ompl_balance.occupancy import OccupancyGrid, OccupancyProblem, rooms_problem
+from ompl_balance.worlds.occupancy import OccupancyGrid, OccupancyProblem, rooms_problem
 from ompl_balance.planners import BallRadiusRRTstar
 
 

@@ -25,8 +25,8 @@ import fcl
 import numpy as np
 from ompl import base as ob
 
-from ompl_balance.mbm import load_mbm
-from ompl_balance.robots import load_panda_vamp
+from ompl_balance.worlds.mbm import load_mbm
+from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.validity import CollisionChecker, StateValidityChecker, setup_robot, space_for
 
 

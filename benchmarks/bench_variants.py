@@ -12,7 +12,7 @@ Then, per preset, the lab's collision-query ratio to plain RRT-Connect (issue #6
 problems the change goes the lab's way: each ratio read as "fewer" (< 0.9), "same"
 (0.9 to 1.1) or "more" (> 1.1) queries, and the lab's way reproduced where the words match.
 
-Problems: the built-in 2-D suite (``ompl_balance.problems``). With ``--mbm N``, also the
+Problems: the built-in 2-D suite (``ompl_balance.worlds.boxes``). With ``--mbm N``, also the
 first N problems of each MotionBenchMaker Panda scenario in ``../shared/data/mbm/panda``
 with VAMP's Panda (exact FCL checks, ~0.3-0.5 ms per state: keep N small).
 
@@ -30,9 +30,9 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ompl_balance.counting import measured_solve
+from ompl_balance.core.counting import measured_solve
 from ompl_balance.planners import PRESETS
-from ompl_balance.problems import PROBLEMS
+from ompl_balance.worlds.boxes import PROBLEMS
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -64,8 +64,8 @@ def effect(ratio: float) -> str:
 
 def mbm_problems(count: int) -> dict:
     """``name -> make_setup`` for the first ``count`` problems of each Panda scenario."""
-    from ompl_balance.mbm import load_mbm
-    from ompl_balance.robots import load_panda_vamp
+    from ompl_balance.worlds.mbm import load_mbm
+    from ompl_balance.collision.robots import load_panda_vamp
     from ompl_balance.validity import CollisionChecker
 
     robot = load_panda_vamp(DATA / "robots" / "panda_vamp")

@@ -6,7 +6,7 @@ Run: python examples/balanced_rrtc_2d.py
 from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect
-from ompl_balance.problems import get_problem
+from ompl_balance.worlds.boxes import get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
 

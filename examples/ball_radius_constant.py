@@ -33,7 +33,7 @@ import numpy as np  # noqa: E402
 from ompl import util as ou  # noqa: E402
 
 from ompl_balance.gamma import ball_radius_constant, estimate_ball_radius_constant, rewire_radius, unit_ball_volume  # noqa: E402
-from ompl_balance.occupancy import OccupancyProblem, rooms_problem  # noqa: E402
+from ompl_balance.worlds.occupancy import OccupancyProblem, rooms_problem  # noqa: E402
 from ompl_balance.planners import BallRadiusRRTstar  # noqa: E402
 
 ETA = 4.0  # m, maximum connection distance on the rooms map

@@ -10,8 +10,8 @@ import time
 import numpy as np
 from ompl import geometric as og
 
-from ompl_balance.counting import read_work
-from ompl_balance.robots import load_example_robot_data_panda
+from ompl_balance.core.counting import read_work
+from ompl_balance.collision.robots import load_example_robot_data_panda
 from ompl_balance.validity import CollisionChecker, Environment, setup_robot, space_for
 
 try:

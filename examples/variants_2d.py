@@ -9,7 +9,7 @@ Run: ``python examples/variants_2d.py``.
 from ompl import util as ou
 
 from ompl_balance.planners import PRESETS, BalancedRRTConnect
-from ompl_balance.problems import get_problem
+from ompl_balance.worlds.boxes import get_problem
 from ompl_balance.samplers import GaussianValidStateSampler
 
 ou.setLogLevel(ou.LOG_WARN)

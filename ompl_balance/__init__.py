@@ -3,17 +3,28 @@
 Planners subclass ``ompl.base.Planner`` and drop into ``og.SimpleSetup`` and
 ``ompl.tools.Benchmark``; they are configured with ``planner.params().setParam``.
 
-The robot layer (URDF kinematics, FCL collision checking, MotionBenchMaker scenes) and
-the benchmark runner are imported on first use, so ``import ompl_balance`` stays quick
-when they are not needed.
+The package is built in layers (``docs/architecture.md``): :mod:`ompl_balance.core`
+(parameters, state points, trees, work counting, the planner base), the planners and
+their policies at the top level (:mod:`~ompl_balance.planners`,
+:mod:`~ompl_balance.policies`, :mod:`~ompl_balance.rrtstar`, :mod:`~ompl_balance.samplers`),
+the robot layer (:mod:`ompl_balance.collision` and its OMPL adapters,
+:mod:`~ompl_balance.validity`), problems (:mod:`ompl_balance.worlds`) and the benchmark
+runner (:mod:`ompl_balance.bench`).
+
+The robot layer (trimesh, FCL, numba) and the benchmark runner are imported on first
+use, so ``import ompl_balance`` stays quick when they are not needed: their names
+(``CollisionChecker``, ``setup_robot``, ``load_mbm``, ``bench``, ...) are attributes of
+this package but not in ``__all__``, so ``from ompl_balance import *`` does not load them.
 """
 
 from __future__ import annotations
 
 import importlib
+from importlib import metadata
 from typing import Any
 
-from .counting import CountingValidityChecker, WorkCount, ensure_counting, read_work
+from .core.counting import CountingValidityChecker, WorkCount, ensure_counting, read_work
+from .core.params import ParamSet
 from .gamma import (
     FreeMeasure,
     ball_radius_constant,
@@ -23,15 +34,8 @@ from .gamma import (
     rewire_radius,
     unit_ball_volume,
 )
-from .occupancy import OCCUPANCY_PROBLEMS, GridValidityChecker, OccupancyGrid, OccupancyProblem, rooms_grid, rooms_problem
-from .params import ParamSet
 from .planners import (
-    NEAREST_POLICIES,
     PRESETS,
-    SAMPLE_POLICIES,
-    SWAP_CAUSES,
-    SWAP_POLICIES,
-    BallRadiusRRTstar,
     BalancedRRTConnect,
     CollisionSwapRRTConnect,
     ControlChosenRRTConnect,
@@ -40,54 +44,73 @@ from .planners import (
     GaussianPassageRRTConnect,
     GoalBiasRRTConnect,
     NeighbourCostRRTConnect,
-    RRTstarStats,
     RunStats,
     SwapLimitRRTConnect,
-    balance_choice,
-    exhaustion_scale,
-    nearest_by_exhaustion,
-    nearest_not_exhausted,
-    node_quality,
-    path_length_objective,
-    tree_chooser,
-    tree_size_ratio,
 )
-from .problems import PROBLEMS, BoxWorld2D, Problem, get_problem
+from .policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause, balance_choice, tree_size_ratio
+from .rrtstar import BallRadiusRRTstar, RRTstarStats
 from .samplers import BridgeTestValidStateSampler, GaussianValidStateSampler, PassageSampler
+from .worlds.boxes import PROBLEMS, BoxWorld2D, Problem, get_problem
+from .worlds.occupancy import (
+    OCCUPANCY_PROBLEMS,
+    GridValidityChecker,
+    OccupancyGrid,
+    OccupancyProblem,
+    rooms_grid,
+    rooms_problem,
+)
 
-# name -> module, for the robot layer (trimesh, FCL) and the benchmark runner, loaded
-# lazily by __getattr__
+try:
+    __version__ = metadata.version("ompl-balance")
+except metadata.PackageNotFoundError:  # run from a source tree that was not installed
+    __version__ = "0+unknown"
+
+#: name -> module of names loaded on first use (the robot layer, the benchmark runner, and
+#: helpers whose home is a module of their own)
 _LAZY = {
-    "Experiment": "experiment",
-    "ProblemSpec": "experiment",
-    "PlannerSpec": "experiment",
-    "RunTask": "experiment",
-    "ExperimentError": "experiment",
-    "load_experiment": "experiment",
-    "run_seed": "experiment",
-    "bench": "benchmark",
-    "compare_experiment": "benchmark",
-    "run_isolated": "runner",
-    "ResultStore": "runner",
-    "sweep": "runner",
-    "write_logs": "ompl_log",
-    "to_database": "ompl_log",
-    "summarize": "summary",
-    "plot_folder": "plots",
-    "RobotModel": "kinematics",
-    "Environment": "validity",
-    "CollisionChecker": "validity",
+    "RobotModel": "collision.kinematics",
+    "Environment": "collision.checker",
+    "CollisionChecker": "collision.checker",
+    "load_example_robot_data_panda": "collision.robots",
+    "load_panda_vamp": "collision.robots",
     "StateValidityChecker": "validity",
     "MotionValidator": "validity",
     "space_for": "validity",
     "setup_robot": "validity",
-    "load_mbm": "mbm",
-    "MBMProblem": "mbm",
-    "load_example_robot_data_panda": "robots",
-    "load_panda_vamp": "robots",
+    "load_mbm": "worlds.mbm",
+    "MBMProblem": "worlds.mbm",
+    "Experiment": "bench.experiment",
+    "ProblemSpec": "bench.experiment",
+    "PlannerSpec": "bench.experiment",
+    "RunTask": "bench.experiment",
+    "ExperimentError": "bench.experiment",
+    "load_experiment": "bench.experiment",
+    "run_seed": "bench.experiment",
+    "bench": "bench.compare",
+    "compare_experiment": "bench.compare",
+    "run_isolated": "bench.runner",
+    "ResultStore": "bench.runner",
+    "sweep": "bench.runner",
+    "write_logs": "bench.logs",
+    "to_database": "bench.logs",
+    "summarize": "bench.summary",
+    "plot_folder": "bench.plots",
+    "SWAP_CAUSES": "policies",
+    "tree_chooser": "policies",
+    "exhaustion_scale": "policies",
+    "nearest_not_exhausted": "policies",
+    "nearest_by_exhaustion": "policies",
+    "node_quality": "policies",
+    "path_length_objective": "rrtstar",
 }
 
 __all__ = [
+    "NEAREST_POLICIES",
+    "OCCUPANCY_PROBLEMS",
+    "PRESETS",
+    "PROBLEMS",
+    "SAMPLE_POLICIES",
+    "SWAP_POLICIES",
     "BallRadiusRRTstar",
     "BalancedRRTConnect",
     "BoxWorld2D",
@@ -102,48 +125,39 @@ __all__ = [
     "GaussianValidStateSampler",
     "GoalBiasRRTConnect",
     "GridValidityChecker",
-    "NEAREST_POLICIES",
     "NeighbourCostRRTConnect",
-    "OCCUPANCY_PROBLEMS",
     "OccupancyGrid",
     "OccupancyProblem",
-    "PRESETS",
-    "PROBLEMS",
     "ParamSet",
     "PassageSampler",
     "Problem",
     "RRTstarStats",
     "RunStats",
-    "SAMPLE_POLICIES",
-    "SWAP_CAUSES",
-    "SWAP_POLICIES",
+    "SwapCause",
     "SwapLimitRRTConnect",
     "WorkCount",
+    "__version__",
     "balance_choice",
     "ball_radius_constant",
     "ensure_counting",
     "estimate_ball_radius_constant",
     "estimate_free_measure",
-    "exhaustion_scale",
     "get_problem",
-    "nearest_by_exhaustion",
-    "nearest_not_exhausted",
-    "node_quality",
     "ompl_rewire_factor",
-    "path_length_objective",
     "read_work",
     "rewire_radius",
     "rooms_grid",
     "rooms_problem",
-    "tree_chooser",
     "tree_size_ratio",
     "unit_ball_volume",
-    *_LAZY,
 ]
-__version__ = "0.1.0"
 
 
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
         return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
     raise AttributeError(f"module 'ompl_balance' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})

@@ -11,6 +11,9 @@
 ``ompl-balance plot OUT/``
     box plots, success-vs-time curves, the summary table and, for 2-D problems, the
     two trees of balanced and alternating growth (needs matplotlib: the ``plot`` extra).
+``ompl-balance gamma``
+    RRT*'s ball-radius constant for a built-in problem or an occupancy grid, and the
+    ``rewire_factor`` that gives OMPL's ``RRTstar`` the same radius schedule.
 
 Every run executes in its own process; ``--jobs N`` runs N at a time, ``--dask
 tcp://HOST:PORT`` or ``--dask local:N`` on a Dask cluster (the ``distributed`` extra).
@@ -24,11 +27,14 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
 from ompl import util as ou
 
-from .benchmark import bench, compare_experiment, parse_planners
-from .experiment import Experiment, ExperimentError, load_experiment
-from .problems import PROBLEMS
+from .bench.compare import bench, compare_experiment, parse_planners
+from .bench.experiment import Experiment, ExperimentError, load_experiment
+from .gamma import ball_radius_constant, estimate_free_measure, ompl_rewire_factor, rewire_radius
+from .worlds.boxes import PROBLEMS
+from .worlds.occupancy import OCCUPANCY_PROBLEMS, OccupancyGrid, OccupancyProblem
 
 
 def _problem_names(text: str) -> list[str]:
@@ -106,8 +112,26 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--tree-iterations", type=_positive_int, default=300,
                       help="iterations at which the 2-D tree pictures are drawn (default 300)")
 
-    # Listed for --help; main() hands `gamma ...` to occupancy.gamma_command, which parses its own options.
-    commands.add_parser("gamma", add_help=False, help="estimate RRT*'s ball-radius constant (ompl-balance gamma --help)")
+    gamma = commands.add_parser(
+        "gamma", help="estimate RRT*'s ball-radius constant for a problem",
+        description="Estimate RRT*'s ball-radius constant gamma* = 2^d (1 + 1/d) mu(X_free) / zeta_d "
+                    "(Karaman & Frazzoli 2011) for a built-in problem or an occupancy grid you give, "
+                    "and the rewire_factor that makes OMPL's RRTstar use the same radius schedule.")
+    source = gamma.add_mutually_exclusive_group()
+    source.add_argument("--problem", default="rooms",
+                        help="built-in problem: rooms, rooms_se2 (occupancy grid, counted exactly) or a box world of "
+                             "'ompl-balance compare' (open, narrow_gap, bug_trap, maze; Monte Carlo). Default: rooms")
+    source.add_argument("--grid", metavar="FILE.npy",
+                        help="a 2-D boolean occupancy array (True = occupied) saved with numpy.save")
+    gamma.add_argument("--resolution", type=_positive_float, default=0.2, help="cell side of --grid in metres (default 0.2)")
+    gamma.add_argument("--samples", type=_positive_int, default=20000,
+                       help="Monte Carlo samples when the measure is estimated (default 20000)")
+    gamma.add_argument("--confidence", type=float, default=0.95, help="confidence level of the interval (default 0.95)")
+    gamma.add_argument("--monte-carlo", action="store_true",
+                       help="estimate by sampling even when a grid allows exact counting")
+    gamma.add_argument("--seed", type=int, default=None, help="seed of the Monte Carlo samples")
+    gamma.add_argument("--eta", type=float, default=0.0,
+                       help="maximum connection distance for the radius table (default 0.2 x extent)")
     return parser
 
 
@@ -119,13 +143,53 @@ def _run(experiment: Experiment, out: Path, args: argparse.Namespace) -> int:
     return 0
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
-    if argv[:1] == ["gamma"]:
-        from .occupancy import gamma_command
+def _gamma(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """``ompl-balance gamma``: print the ball-radius constant of a problem."""
+    if args.grid is not None:
+        try:
+            grid = OccupancyGrid(np.load(args.grid), args.resolution)
+        except (OSError, ValueError) as error:
+            parser.error(f"--grid {args.grid}: {error}")
+        problem_name = args.grid
+        ss = OccupancyProblem(args.grid, grid, grid.low, grid.high).setup()
+    elif args.problem in OCCUPANCY_PROBLEMS:
+        problem_name, problem = args.problem, OCCUPANCY_PROBLEMS[args.problem]()
+        grid, ss = problem.grid, problem.setup()
+    elif args.problem in PROBLEMS:  # the box worlds have no grid: Monte Carlo only
+        problem_name, grid, ss = args.problem, None, PROBLEMS[args.problem].setup()
+    else:
+        parser.error(f"unknown problem {args.problem!r}; built-in problems: {', '.join([*OCCUPANCY_PROBLEMS, *PROBLEMS])}")
 
-        return gamma_command(argv[1:])
-    args = build_parser().parse_args(argv)
+    si = ss.getSpaceInformation()
+    try:
+        free = estimate_free_measure(
+            si, samples=args.samples, confidence=args.confidence, grid=None if args.monte_carlo else grid, rng=args.seed
+        )
+    except ValueError as error:
+        parser.error(str(error))
+    d = si.getStateDimension()
+    gamma = ball_radius_constant(d, free.high)
+    eta = args.eta if args.eta > 0 else 0.2 * si.getMaximumExtent()
+    print(f"problem            {problem_name} ({si.getStateSpace().getName()}, d = {d})")
+    print(f"space measure      {free.space_measure:.6g}")
+    if free.exact:
+        print(f"free measure       {free.measure:.6g} (exact, {free.free_fraction:.2%} of the space, from the grid cells)")
+    else:
+        print(
+            f"free measure       {free.measure:.6g}, {free.confidence:.0%} interval [{free.low:.6g}, {free.high:.6g}] "
+            f"({free.samples} samples, {free.free_fraction:.2%} free)"
+        )
+    print(f"gamma*             {gamma:.6g}  (from the {'exact' if free.exact else 'upper'} free measure)")
+    print(f"OMPL rewire_factor {ompl_rewire_factor(si, gamma):.6g}  (RRTstar, setKNearest(False), range = eta)")
+    for n in (100, 1000, 10000):
+        print(f"radius at N={n:<6} {rewire_radius(n, d, gamma, eta):.4g}  "
+              f"(gamma = 100: {rewire_radius(n, d, 100.0, eta):.4g}; eta = {eta:.4g})")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
     ou.setLogLevel(ou.LOG_WARN)
     try:
         if args.command == "compare":
@@ -138,11 +202,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "bench":
             return _run(load_experiment(args.experiment), args.out, args)
         if args.command == "plot":
-            from .plots import plot_folder
+            from .bench.plots import plot_folder
 
             for path in plot_folder(args.out, baseline=args.baseline, tree_iterations=args.tree_iterations):
                 print(path)
             return 0
+        if args.command == "gamma":
+            return _gamma(args, parser)
     except ExperimentError as error:
         print(f"ompl-balance {args.command}: {error}", file=sys.stderr)
         return 2

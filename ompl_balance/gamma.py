@@ -51,7 +51,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from .spaces import points_for
+from .core.spaces import points_for
 
 
 def unit_ball_volume(d: int) -> float:
@@ -139,7 +139,7 @@ def estimate_free_measure(
     ``ompl.util.RNG.setSeed``).
 
     With ``grid`` (a boolean occupancy array, ``True`` = occupied, or an object with
-    such an ``occupied`` attribute, e.g. :class:`~ompl_balance.occupancy.OccupancyGrid`)
+    such an ``occupied`` attribute, e.g. :class:`~ompl_balance.worlds.occupancy.OccupancyGrid`)
     the free fraction is counted exactly over the cells. This assumes the grid covers
     exactly the position bounds of the space and validity depends on position alone
     (other components, such as SE2's heading, then contribute their whole measure).

@@ -29,7 +29,7 @@ OMPL's Python bindings do not expose the first two. All three:
   so ``ompl.util.RNG.setSeed`` makes them repeat;
 * count the states they check in ``validity_checks`` (collision queries like any
   other: they go through ``si.isValid`` and so through the counting checker too);
-* have a :class:`~ompl_balance.params.ParamSet` (``params()``) with
+* have a :class:`~ompl_balance.core.params.ParamSet` (``params()``) with
   ``standard_deviation`` (default 0.1 x the space's maximum extent, as OMPL; 0.05 x
   for :class:`PassageSampler`).
 """
@@ -37,17 +37,53 @@ OMPL's Python bindings do not expose the first two. All three:
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 from ompl import base as ob
 
-from .params import ParamSet
+from .core.params import ParamSet, Settings, add_accessors, param
 
 #: OMPL's ``magic::STD_DEV_AS_SPACE_EXTENT_FRACTION``.
 STD_DEV_AS_EXTENT_FRACTION = 0.1
 
 
+@dataclass
+class NearObstacleSettings(Settings):
+    """The parameter of the Gaussian and bridge-test samplers."""
+
+    standard_deviation: float = param(
+        math.nan, "standard deviation of the Gaussian neighbour (state-space distance); set at construction "
+        "to a fraction of the space's maximum extent (0.1, OMPL's default; 0.05 for PassageSampler)",
+        low=0.0, low_open=True, suggestion="0.:0.01:10.", accessor="StdDev")
+
+
+@dataclass
+class PassageSettings(NearObstacleSettings):
+    """The parameters of :class:`PassageSampler`."""
+
+    neighbours: int = param(8, "Gaussian neighbours drawn around each candidate (k)", low=1, suggestion="1:1:64")
+    min_colliding: int = param(1, "fewest neighbours in collision for the candidate to be a sample", low=0,
+                               suggestion="0:1:64")
+    max_colliding: int = param(7, "most neighbours in collision for the candidate to be a sample", low=0,
+                               suggestion="0:1:64")
+
+    def check(self) -> None:
+        if not 0 <= self.min_colliding <= self.max_colliding <= self.neighbours:
+            raise ValueError(
+                "need 0 <= min_colliding <= max_colliding <= neighbours, got "
+                f"{self.min_colliding}, {self.max_colliding}, {self.neighbours}"
+            )
+
+
 class _NearObstacleSampler(ob.ValidStateSampler):
-    """What the three samplers share: OMPL's sampler and checker, counting, the deviation."""
+    """What the three samplers share: OMPL's sampler and checker, counting, the parameters."""
+
+    Settings: type[NearObstacleSettings] = NearObstacleSettings
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        add_accessors(cls, cls.Settings)
 
     def __init__(self, si: ob.SpaceInformation, name: str, stddev_fraction: float) -> None:
         super().__init__(si)
@@ -57,25 +93,17 @@ class _NearObstacleSampler(ob.ValidStateSampler):
         self._copy = si.copyState
         self._interpolate = si.getStateSpace().interpolate
         self._scratch = si.allocState()  # the second state of a pair
-        self._stddev = stddev_fraction * si.getMaximumExtent()
+        self.settings = self.Settings()
+        self.settings.set("standard_deviation", stddev_fraction * si.getMaximumExtent())
+        self._params = ParamSet.of(self.settings)
         self.validity_checks = 0
-        self._params = ParamSet()
-        self._params.declareParam("standard_deviation", self.setStdDev, self.getStdDev, "0.:0.01:10.", float)
 
     def params(self) -> ParamSet:
         return self._params
 
-    def setStdDev(self, stddev: float) -> None:  # noqa: N802 (OMPL's names)
-        if not math.isfinite(stddev) or stddev <= 0:
-            raise ValueError("standard_deviation must be a finite distance > 0")
-        self._stddev = float(stddev)
-
-    def getStdDev(self) -> float:  # noqa: N802
-        return self._stddev
-
     def _check(self, state: ob.State) -> bool:
         self.validity_checks += 1
-        return self._is_valid_in_si(state)
+        return bool(self._is_valid_in_si(state))
 
     def _draw(self, state: ob.State, near: ob.State | None, distance: float) -> None:
         """A uniform state: anywhere when ``near`` is ``None``, else within ``distance`` of it."""
@@ -85,7 +113,7 @@ class _NearObstacleSampler(ob.ValidStateSampler):
             self._states.sampleUniformNear(state, near, distance)
 
     def sample(self, state: ob.State) -> bool:
-        return self._sample(state, None, self._stddev)
+        return self._sample(state, None, self.settings.standard_deviation)
 
     def sampleNear(self, state: ob.State, near: ob.State, distance: float) -> bool:  # noqa: N802
         return self._sample(state, near, distance)
@@ -151,6 +179,9 @@ class PassageSampler(_NearObstacleSampler):
         maximum extent (the lab used 0.05).
     """
 
+    Settings = PassageSettings
+    settings: PassageSettings
+
     def __init__(
         self,
         si: ob.SpaceInformation,
@@ -160,44 +191,12 @@ class PassageSampler(_NearObstacleSampler):
         stddev_fraction: float = 0.05,
     ) -> None:
         super().__init__(si, "passage", stddev_fraction)
-        self._neighbours = 0
-        self._min_colliding = 0
-        self._max_colliding = 0
-        self._set_counts(neighbours, min_colliding, neighbours - 1 if max_colliding is None else max_colliding)
-        self._params.declareParam("neighbours", self.setNeighbours, self.getNeighbours, "1:1:64", int)
-        self._params.declareParam("min_colliding", self.setMinColliding, self.getMinColliding, "0:1:64", int)
-        self._params.declareParam("max_colliding", self.setMaxColliding, self.getMaxColliding, "0:1:64", int)
-
-    def _set_counts(self, neighbours: int, min_colliding: int, max_colliding: int) -> None:
-        if neighbours < 1:
-            raise ValueError(f"neighbours must be >= 1, got {neighbours}")
-        if not 0 <= min_colliding <= max_colliding <= neighbours:
-            raise ValueError(
-                f"need 0 <= min_colliding <= max_colliding <= neighbours, got {min_colliding}, {max_colliding}, {neighbours}"
-            )
-        self._neighbours, self._min_colliding, self._max_colliding = int(neighbours), int(min_colliding), int(max_colliding)
-
-    def setNeighbours(self, neighbours: int) -> None:  # noqa: N802
-        self._set_counts(neighbours, self._min_colliding, min(self._max_colliding, neighbours))
-
-    def getNeighbours(self) -> int:  # noqa: N802
-        return self._neighbours
-
-    def setMinColliding(self, count: int) -> None:  # noqa: N802
-        self._set_counts(self._neighbours, count, self._max_colliding)
-
-    def getMinColliding(self) -> int:  # noqa: N802
-        return self._min_colliding
-
-    def setMaxColliding(self, count: int) -> None:  # noqa: N802
-        self._set_counts(self._neighbours, self._min_colliding, count)
-
-    def getMaxColliding(self) -> int:  # noqa: N802
-        return self._max_colliding
+        self.settings.update({"neighbours": neighbours, "min_colliding": min_colliding,
+                              "max_colliding": neighbours - 1 if max_colliding is None else max_colliding})
 
     def _sample(self, state: ob.State, near: ob.State | None, stddev: float) -> bool:
-        neighbour, k = self._scratch, self._neighbours
-        low, high = self._min_colliding, self._max_colliding
+        neighbour, k = self._scratch, self.settings.neighbours
+        low, high = self.settings.min_colliding, self.settings.max_colliding
         for _ in range(self.getNrAttempts()):
             self._draw(state, near, stddev)
             if not self._check(state):

@@ -45,8 +45,7 @@ from dataclasses import dataclass, field
 from ompl import base as ob
 from ompl import geometric as og
 
-import ompl_balance.planners as package_planners_module
-from ompl_balance import BalancedRRTConnect, read_work
+from ompl_balance import PRESETS, BallRadiusRRTstar, BalancedRRTConnect, read_work
 from ompl_envs import Circles2D, CircleQuery, Environment2D, circles_space_information, map_space_information
 from pathcheck import invalid_points
 
@@ -123,12 +122,10 @@ def package_planners() -> list[PlannerEntry]:
         PlannerEntry("BalancedRRTConnect", configured(BalancedRRTConnect, balance_tree_sizes=True)),
         PlannerEntry("BalancedRRTConnect[balance=0]", configured(BalancedRRTConnect, balance_tree_sizes=False)),
     ]
-    for name, planner_class in getattr(package_planners_module, "PRESETS", {}).items():
+    for name, planner_class in PRESETS.items():
         if planner_class is not BalancedRRTConnect:  # listed above, balancing on and off
             entries.append(PlannerEntry(name, configured(planner_class)))
-    rrt_star = getattr(package_planners_module, "BallRadiusRRTstar", None)
-    if rrt_star is not None:
-        entries.append(PlannerEntry("BallRadiusRRTstar", configured(rrt_star)))
+    entries.append(PlannerEntry("BallRadiusRRTstar", configured(BallRadiusRRTstar)))
     return entries
 
 

@@ -4,7 +4,7 @@ Python versions of ``tests/resources/environment2D.h`` (occupancy grid),
 ``tests/resources/circles2D.h`` (circular obstacles and queries),
 ``tests/geometric/2d/2DmapSetup.h`` and ``tests/geometric/2d/2DcirclesSetup.h``
 (the space information OMPL's ``2denvs.cpp`` plans in), reading the resource files
-byte-copied to ``../shared/data/ompl_tests/``.
+the package ships (``ompl_balance/data/ompl_2d/``, byte copies of OMPL's).
 
 Validity rules are OMPL's: a map state is valid when the grid cell it falls in
 (coordinates rounded towards zero) exists and is free (0); a circles state is valid
@@ -20,14 +20,15 @@ Python override would only add a Python call per distance, so the plain space is
 from __future__ import annotations
 
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 from ompl import base as ob
 
 from ompl_balance import CountingValidityChecker
 
-#: Where the resource files live: ``../shared/data/ompl_tests/`` beside the repository.
-RESOURCES = Path(__file__).resolve().parents[2] / "shared" / "data" / "ompl_tests"
+#: Where the resource files live: shipped with the package.
+RESOURCES = Path(str(resources.files("ompl_balance") / "data" / "ompl_2d"))
 
 T_FREE = 0  # the free grid cell value of environment2D.h
 

@@ -9,14 +9,13 @@ from pathlib import Path
 
 import pytest
 
-from ompl_balance.benchmark import bench, compare_experiment, parse_planners
+from ompl_balance.bench.compare import bench, compare_experiment, parse_planners
 from ompl_balance.cli import main
-from ompl_balance.experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec, load_experiment, run_seed
-from ompl_balance.ompl_log import write_logs
-from ompl_balance.runner import run_isolated
-from ompl_balance.summary import summarize
+from ompl_balance.bench.experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec, load_experiment, run_seed
+from ompl_balance.bench.logs import write_logs
+from ompl_balance.bench.runner import run_isolated
+from ompl_balance.bench.summary import summarize
 
-SHARED = Path(__file__).resolve().parents[2] / "shared"
 
 GOOD = """\
 name = "tiny"
@@ -73,7 +72,7 @@ def test_experiment_file_reads_planners_params_and_seeds(tmp_path):
         (("range = 0.3", "rang = 0.3"), ["planners[0].params.rang", "line 11", "range"]),
         (("runs = 2", "runs = -3"), ["runs", "line 2", "whole number >= 1"]),
         (("time_limit = 1.0", "time_limit = 0"), ["time_limit", "line 3", "positive"]),
-        (('builtin = "open"', 'mbm = "nowhere.json"\nrobot = "."'), ["problems[0].mbm", "line 7", "no such file", "nowhere.json"]),
+        (('builtin = "open"', 'mbm = "nowhere.json"\nrobot = "."'), ["problems[0].mbm", "line 7", "nor a file", "nowhere.json"]),
         (('builtin = "open"', 'builtin = "opne"'), ["problems[0].builtin", "line 7", "narrow_gap"]),
         (("seed = 7", "sede = 7"), ["sede", "line 4", "unknown key"]),
         (("runs = 2", "runs = 2 ]"), ["not valid TOML", "line 2"]),
@@ -92,10 +91,7 @@ def test_bad_experiment_files_fail_before_any_run_naming_key_and_line(tmp_path, 
 
 
 def test_mbm_problems_expand_ids_and_ranges(tmp_path):
-    scenario = SHARED / "data" / "mbm" / "panda" / "table_pick.json"
-    if not scenario.is_file():
-        pytest.skip(f"shared data not found at {scenario}")
-    text = GOOD.replace('builtin = "open"', f'mbm = "{scenario}"\nrobot = "{SHARED / "data/robots/panda_vamp"}"\nids = [3, "10-12"]')
+    text = GOOD.replace('builtin = "open"', 'mbm = "table_pick"\nids = [3, "10-12"]')
     experiment = load_experiment(write(tmp_path, text))
     assert [p.name for p in experiment.problems] == ["table_pick.003", "table_pick.010", "table_pick.011", "table_pick.012"]
     with pytest.raises(ExperimentError, match=r"problems\[0\].ids: ids \[101\] not in the file"):
@@ -203,7 +199,7 @@ def test_summary_ratios_are_to_the_baseline(tiny_sweep):
 
 def test_plot_writes_boxplots_curves_and_trees(tiny_sweep):
     pytest.importorskip("matplotlib")
-    from ompl_balance.plots import grow_trees, plot_folder
+    from ompl_balance.bench.plots import grow_trees, plot_folder
 
     _, out, _ = tiny_sweep
     written = plot_folder(out, tree_iterations=40)
@@ -227,7 +223,7 @@ def test_write_logs_leaves_blank_what_a_crashed_run_lacks(tiny_sweep, tmp_path):
 
 
 def test_pooling_by_scenario_makes_one_cell_per_scenario_and_planner():
-    from ompl_balance.summary import pooled_by_scenario, summarize
+    from ompl_balance.bench.summary import pooled_by_scenario, summarize
 
     def record(problem, planner, time_s):
         return {"problem": problem, "planner": planner, "error": "",

@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 from ompl import base as ob
 
-from ompl_balance.benchmark import bench
-from ompl_balance.experiment import Experiment, PlannerSpec, ProblemSpec
+from ompl_balance.bench.compare import bench
+from ompl_balance.bench.experiment import Experiment, PlannerSpec, ProblemSpec
 from test_benchmark import deterministic
 
 REPO = Path(__file__).resolve().parents[1]

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from ompl_balance.cache import cache_dir, cached_arrays
-from ompl_balance.validity import CollisionChecker
-from test_validity import DATA, arm3_scene, needs_data
+from ompl_balance.collision.cache import cache_dir, cached_arrays
+from ompl_balance.collision.checker import CollisionChecker
+from test_validity import arm3_scene
 
 
 def counting(calls: list):
@@ -65,11 +65,10 @@ def test_checker_volumes_from_the_cache_equal_computed_ones_arm3(tmp_path, monke
         np.testing.assert_array_equal(value, getattr(read, name), err_msg=name)
 
 
-@needs_data
 def test_checker_volumes_from_the_cache_equal_computed_ones_panda(tmp_path, monkeypatch):
-    from ompl_balance.robots import load_panda_vamp
+    from ompl_balance.collision.robots import load_panda_vamp
 
-    computed, read = volumes_without_and_with_cache(lambda: load_panda_vamp(DATA / "robots" / "panda_vamp"),
+    computed, read = volumes_without_and_with_cache(lambda: load_panda_vamp(),
                                                      tmp_path, monkeypatch)
     assert (computed.pair_table >= 0).any()  # the tables are among what was cached
     for name, value in computed._asdict().items():

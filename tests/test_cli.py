@@ -44,7 +44,7 @@ def test_bad_options_are_refused_with_a_reason(args, message, capsys):
 
 def test_gamma_prints_the_estimate_for_a_builtin_problem(capsys):
     from ompl_balance.gamma import ball_radius_constant
-    from ompl_balance.occupancy import rooms_grid
+    from ompl_balance.worlds.occupancy import rooms_grid
 
     assert main(["gamma", "--problem", "rooms"]) == 0
     out = capsys.readouterr().out

@@ -19,7 +19,8 @@ from ompl_balance.gamma import (
     rewire_radius,
     unit_ball_volume,
 )
-from ompl_balance.occupancy import GridValidityChecker, OccupancyGrid, OccupancyProblem, gamma_command, rooms_problem
+from ompl_balance.cli import main
+from ompl_balance.worlds.occupancy import GridValidityChecker, OccupancyGrid, OccupancyProblem, rooms_problem
 
 ou.setLogLevel(ou.LOG_WARN)
 PI = math.pi
@@ -246,15 +247,15 @@ def test_occupancy_grid_rejects_bad_input():
 
 
 def test_gamma_command_prints_the_exact_estimate(capsys):
-    assert gamma_command(["--problem", "rooms"]) == 0
+    assert main(["gamma", "--problem", "rooms"]) == 0
     out = capsys.readouterr().out
     gamma_star = ball_radius_constant(2, rooms_problem().grid.free_area)
     assert f"{gamma_star:.6g}" in out and "exact" in out
 
 
 def test_gamma_command_monte_carlo_and_bad_problem(capsys):
-    assert gamma_command(["--problem", "maze", "--samples", "500", "--seed", "1"]) == 0
+    assert main(["gamma", "--problem", "maze", "--samples", "500", "--seed", "1"]) == 0
     assert "interval" in capsys.readouterr().out
     with pytest.raises(SystemExit):
-        gamma_command(["--problem", "nowhere"])
+        main(["gamma", "--problem", "nowhere"])
     assert "unknown problem 'nowhere'" in capsys.readouterr().err

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 import yourdfpy
 
-from ompl_balance.kinematics import RobotModel
+from ompl_balance.collision.kinematics import RobotModel
 
 ROBOTS = Path(__file__).resolve().parent / "robots"
-PANDA_VAMP = Path(__file__).resolve().parents[2] / "shared" / "data" / "robots" / "panda_vamp"
+from ompl_balance.collision.robots import PANDA_VAMP_DIR as PANDA_VAMP
 
 
 def load_arm3():
@@ -52,7 +52,6 @@ def test_fk_single_configuration_and_batch_agree():
     np.testing.assert_allclose(robot.fk(q)[2], robot.fk(q[2])[0], atol=1e-12, rtol=0)
 
 
-@pytest.mark.skipif(not PANDA_VAMP.is_dir(), reason=f"shared data not found at {PANDA_VAMP}")
 def test_fk_matches_yourdfpy_panda_vamp():
     robot = RobotModel.from_urdf(PANDA_VAMP / "panda.urdf", PANDA_VAMP / "panda.srdf")
     assert robot.dof == 7 and len(robot.geometries) == 11
@@ -60,7 +59,7 @@ def test_fk_matches_yourdfpy_panda_vamp():
 
 
 def test_fk_matches_yourdfpy_example_robot_data_panda():
-    robots = pytest.importorskip("ompl_balance.robots")
+    robots = pytest.importorskip("ompl_balance.collision.robots")
     try:
         robot = robots.load_example_robot_data_panda()
     except ImportError as error:

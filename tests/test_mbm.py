@@ -6,12 +6,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ompl_balance.mbm import load_mbm
-from ompl_balance.validity import CollisionChecker
+from ompl_balance.worlds.mbm import load_mbm
+from ompl_balance.collision.checker import CollisionChecker
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 SCENARIOS = ["table_pick", "table_under_pick", "box", "bookshelf_small"]
-needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"shared data not found at {DATA}")
 
 PROBLEM = {
     "id": 7, "start": [0.0, 0.1, 0.2], "goals": [[0.3, 0.4, 0.5]], "valid": True,
@@ -72,13 +70,12 @@ def test_bad_values(tmp_path):
         load_mbm(tmp_path / "broken.json")
 
 
-@needs_data
 @pytest.mark.parametrize("scenario", SCENARIOS)
 def test_starts_and_goals_valid_with_vamp_panda(scenario):
-    from ompl_balance.robots import load_panda_vamp
+    from ompl_balance.collision.robots import load_panda_vamp
 
-    robot = load_panda_vamp(DATA / "robots" / "panda_vamp")
-    problems = load_mbm(DATA / "mbm" / "panda" / f"{scenario}.json", robot.joint_names)
+    robot = load_panda_vamp()
+    problems = load_mbm(scenario, robot.joint_names)
     assert len(problems) == 100
     bad_start, no_goal = [], []
     for problem in problems:

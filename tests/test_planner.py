@@ -12,7 +12,7 @@ from ompl import tools as ot
 from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect, balance_choice, read_work, tree_size_ratio
-from ompl_balance.problems import PROBLEMS, BoxWorld2D, get_problem
+from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, get_problem
 from fresh_process import run_with_seed
 from pathcheck import assert_valid_solution
 
@@ -427,7 +427,7 @@ from ompl import util as ou
 ou.RNG.setSeed(int(sys.argv[1]))
 ou.setLogLevel(ou.LOG_NONE)
 from ompl_balance import BalancedRRTConnect
-from ompl_balance.problems import get_problem
+from ompl_balance.worlds.boxes import get_problem
 ss = get_problem("maze").setup()
 ss.setPlanner(BalancedRRTConnect(ss.getSpaceInformation()))
 ss.solve(10.0)

@@ -12,9 +12,9 @@ from ompl import tools as ot
 from ompl import util as ou
 
 from ompl_balance.gamma import ball_radius_constant
-from ompl_balance.occupancy import rooms_problem
-from ompl_balance.planners import BallRadiusRRTstar
-from ompl_balance.problems import get_problem
+from ompl_balance.worlds.occupancy import rooms_problem
+from ompl_balance.rrtstar import BallRadiusRRTstar
+from ompl_balance.worlds.boxes import get_problem
 from pathcheck import assert_valid_solution
 
 ou.setLogLevel(ou.LOG_WARN)
@@ -189,11 +189,13 @@ def test_parameters_and_camel_case_accessors():
         "max_nodes",
         "seed",
     }
-    assert params.getParam("ball_radius_constant") == "100.0" and params.getParam("goal_bias") == "0.05"
-    assert params.setParam("ball_radius_constant", "auto") and planner.getBallRadiusConstant() == "auto"
-    assert planner.getBallRadiusConstantInUse() is None
+    # the default is the estimate, and says so (MATLAB's default is 100 whatever the map)
+    assert params.getParam("ball_radius_constant") == "auto" and params.getParam("goal_bias") == "0.05"
+    assert planner.getBallRadiusConstantInUse() is None  # estimated at setup()
     planner.setBallRadiusConstant(250.0)
     assert params.getParam("ball_radius_constant") == "250.0" and planner.getBallRadiusConstantInUse() == 250.0
+    assert params.setParam("ball_radius_constant", "auto") and planner.getBallRadiusConstant() == "auto"
+    assert planner.getBallRadiusConstantInUse() is None
 
 
 @pytest.mark.parametrize(

@@ -10,7 +10,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ompl_balance.problems import BoxWorld2D, get_problem
+from ompl_balance.worlds.boxes import BoxWorld2D, get_problem
 from ompl_balance.samplers import BridgeTestValidStateSampler, GaussianValidStateSampler, PassageSampler
 from fresh_process import run_with_seed
 
@@ -163,7 +163,7 @@ SEEDED_SAMPLES = """
 import sys
 from ompl import util as ou
 ou.RNG.setSeed(int(sys.argv[1]))
-from ompl_balance.problems import get_problem
+from ompl_balance.worlds.boxes import get_problem
 from ompl_balance.samplers import BridgeTestValidStateSampler, GaussianValidStateSampler, PassageSampler
 si = get_problem("maze").setup().getSpaceInformation()
 state = si.allocState()

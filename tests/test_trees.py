@@ -5,7 +5,7 @@ import pytest
 from ompl import base as ob
 
 from fresh_process import run_with_seed
-from ompl_balance.trees import NO_PARENT, ArrayTree, StateTree
+from ompl_balance.core.trees import NO_PARENT, ArrayTree, StateTree
 
 
 @pytest.mark.parametrize(("dim", "offset", "scale"), [(2, 0.0, 1.0), (7, 0.0, 1.0), (3, 1e6, 1e-3), (7, -50.0, 1e-6)])
@@ -56,7 +56,7 @@ def test_import_stays_quick():
         "import ompl_balance\n"
         "from ompl import base as ob, util as ou\n"
         "ou.setLogLevel(ou.LOG_WARN)\n"
-        "print('numba' in sys.modules, 'ompl_balance.scans' in sys.modules)\n"
+        "print('numba' in sys.modules, 'ompl_balance.core.scans' in sys.modules)\n"
         "space = ob.RealVectorStateSpace(2)\n"
         "space.setBounds(0.0, 1.0)\n"
         "si = ob.SpaceInformation(space)\n"
@@ -65,7 +65,7 @@ def test_import_stays_quick():
         "planner = ompl_balance.BalancedRRTConnect(si)\n"
         "planner.setProblemDefinition(ob.ProblemDefinition(si))\n"
         "planner.setup()\n"
-        "print('ompl_balance.scans' in sys.modules)\n"
+        "print('ompl_balance.core.scans' in sys.modules)\n"
     )
     assert run_with_seed(script, 0).split() == ["False", "False", "True"]
 

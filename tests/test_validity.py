@@ -10,14 +10,14 @@ import yourdfpy
 from ompl import base as ob
 from ompl import geometric as og
 
-from ompl_balance.counting import read_work
-from ompl_balance.kinematics import RobotModel
-from ompl_balance.validity import (CollisionChecker, Environment, MotionValidator, StateValidityChecker,
-                                   coarse_to_fine, setup_robot, space_for)
+from ompl_balance.core.counting import read_work
+from ompl_balance.collision.kinematics import RobotModel
+from ompl_balance.collision.checker import CollisionChecker, Environment
+from ompl_balance.collision.robots import PANDA_VAMP_DIR, load_panda_vamp
+from ompl_balance.validity import MotionValidator, StateValidityChecker, coarse_to_fine, setup_robot, space_for
+from ompl_balance.worlds.mbm import load_mbm
 
 ROBOTS = Path(__file__).resolve().parent / "robots"
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"shared data not found at {DATA}")
 
 
 def arm3_scene():
@@ -31,12 +31,9 @@ def arm3_scene():
 
 
 def panda_scene():
-    from ompl_balance.mbm import load_mbm
-    from ompl_balance.robots import load_panda_vamp
-
-    robot = load_panda_vamp(DATA / "robots" / "panda_vamp")
-    problem = load_mbm(DATA / "mbm" / "panda" / "table_pick.json", robot.joint_names)[0]
-    return robot, problem.environment, DATA / "robots" / "panda_vamp" / "panda.urdf"
+    robot = load_panda_vamp()
+    problem = load_mbm("table_pick", robot.joint_names)[0]
+    return robot, problem.environment, PANDA_VAMP_DIR / "panda.urdf"
 
 
 def independent_answers(robot, environment, urdf_path, q):
@@ -82,12 +79,10 @@ def test_collisions_agree_with_independent_fcl_arm3():
     check_scene(arm3_scene(), 300, seed=1)
 
 
-@needs_data
 def test_collisions_agree_with_independent_fcl_panda_table_pick():
     check_scene(panda_scene(), 250, seed=2)
 
 
-@needs_data
 def test_certified_free_tables_hold_no_contact_panda():
     # the forearm (link5) and everything below joint 7 are always close: their pairs get
     # tables over joints 6 and 7; a free cell must hold no contact anywhere in it, so
@@ -192,7 +187,6 @@ def test_motion_validator_matches_discrete_arm3():
     check_motion_validator(robot, environment, 60, seed=3)
 
 
-@needs_data
 def test_motion_validator_matches_discrete_panda():
     robot, environment, _ = panda_scene()
     check_motion_validator(robot, environment, 40, seed=4)
@@ -255,8 +249,8 @@ def test_warm_up_compiles_the_kernels_real_checkers_use():
     # the runner's forkserver warms the kernels with stand-in arrays: their types must be the
     # ones real robots pass, or each run would compile (or load) the kernels again; so the
     # process never holds more than one compiled version of each, whatever ran before
-    from ompl_balance.kinematics import _chain_poses_batch
-    from ompl_balance.screening import screen, warm_up
+    from ompl_balance.collision.kinematics import _chain_poses_batch
+    from ompl_balance.collision.screening import screen, warm_up
 
     warm_up()
     robot, environment, _ = arm3_scene()

@@ -12,17 +12,11 @@ from ompl import tools as ot
 from ompl import util as ou
 
 import ompl_balance.planners as planners
-from ompl_balance.planners import (
-    ALTERNATE,
-    BALANCE,
-    COLLISION,
-    PRESETS,
+from ompl_balance.planners import PRESETS, BalancedRRTConnect, Extender, GaussianPassageRRTConnect, Grow
+from ompl_balance.policies import (
     SAMPLE_POLICIES,
-    STEPS,
     SWAP_POLICIES,
-    BalancedRRTConnect,
-    GaussianPassageRRTConnect,
-    Grow,
+    SwapCause,
     balance_choice,
     exhaustion_scale,
     nearest_by_exhaustion,
@@ -30,7 +24,9 @@ from ompl_balance.planners import (
     node_quality,
     tree_chooser,
 )
-from ompl_balance.problems import get_problem
+
+ALTERNATE, BALANCE, STEPS, COLLISION = SwapCause
+from ompl_balance.worlds.boxes import get_problem
 from ompl_balance.samplers import GaussianValidStateSampler
 from pathcheck import assert_valid_solution
 
@@ -47,8 +43,8 @@ def test_alternate_always_swaps(grew_start):
         assert choose(grew_start, *sizes, steps, collided) == (not grew_start, ALTERNATE)
 
 
-def test_balance_nodes_is_the_balancing_rule_else_alternation():
-    choose = tree_chooser("balance_nodes", max_tree_size_ratio=1.0)
+def test_balancing_is_the_balancing_rule_else_the_swap_policy():
+    choose = tree_chooser("alternate", balance_tree_sizes=True, max_tree_size_ratio=1.0)
     for start_size, goal_size in ((10, 10), (10, 19), (10, 20), (20, 10), (1, 100)):
         for grew_start in (True, False):
             rule = balance_choice(start_size, goal_size, True, 1.0)
@@ -71,7 +67,7 @@ def test_on_collision_swaps_only_after_a_collision():
 
 
 def test_unknown_swap_policy_names_the_accepted_ones():
-    with pytest.raises(ValueError, match="alternate, balance_nodes, balance_steps, on_collision"):
+    with pytest.raises(ValueError, match="alternate, balance_steps, on_collision"):
         tree_chooser("sometimes")
 
 
@@ -138,14 +134,14 @@ def traced_run(monkeypatch, problem: str, **params):
     ss = get_problem(problem).setup()
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     assert planner.params().setParams({key: str(value) for key, value in params.items()})
-    real_grow = planner._grow
+    real_grow = Extender.grow
 
-    def recording_grow(tree, from_start, target, nearest=None):
-        outcome = real_grow(tree, from_start, target, nearest)
+    def recording_grow(extender, tree, from_start, target, nearest=None):
+        outcome = real_grow(extender, tree, from_start, target, nearest)
         events.append(("grow", from_start, np.array(target, dtype=float), nearest is not None, outcome[0]))
         return outcome
 
-    planner._grow = recording_grow
+    monkeypatch.setattr(Extender, "grow", recording_grow)
     ss.setPlanner(planner)
     assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
     return ss, planner, events
@@ -168,7 +164,7 @@ def replay_swaps(events):
 
 
 def test_balance_steps_swaps_after_exactly_swap_steps_connect_steps(monkeypatch):
-    ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="balance_steps", swap_steps=3)
+    ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="balance_steps", swap_steps=3, balance_tree_sizes=0)
     decisions = replay_swaps(events)
     assert len(decisions) > 20
     for grew_start, grow_start, steps, _ in decisions:
@@ -180,7 +176,7 @@ def test_balance_steps_swaps_after_exactly_swap_steps_connect_steps(monkeypatch)
 
 
 def test_on_collision_never_swaps_after_a_collision_free_connect(monkeypatch):
-    ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="on_collision")
+    ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="on_collision", balance_tree_sizes=0)
     decisions = replay_swaps(events)
     swaps = [(grew, grow, collided) for grew, grow, _, collided in decisions]
     assert any(grew != grow for grew, grow, _ in swaps)
@@ -231,10 +227,10 @@ def test_exhausted_policy_never_extends_an_exhausted_node(monkeypatch):
     planner.setNearestPolicy("exhausted")
     planner.setExhaustedAfter(2)
     picks = []
-    make_finder = planner._failure_nearest  # the policy's node finder, built once per solve
+    make_finder = planners.nearest_finder  # the policy's node finder, built once per solve
 
-    def checking_finder():
-        find = make_finder()
+    def checking_finder(*args, **kwargs):
+        find = make_finder(*args, **kwargs)
 
         def checked(tree, target):
             node, distance = find(tree, target)
@@ -244,7 +240,7 @@ def test_exhausted_policy_never_extends_an_exhausted_node(monkeypatch):
 
         return checked
 
-    monkeypatch.setattr(planner, "_failure_nearest", checking_finder)
+    monkeypatch.setattr(planners, "nearest_finder", checking_finder)
     ss.setPlanner(planner)
     assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
     assert len(picks) > 10 and all(picks)
@@ -411,20 +407,23 @@ def test_choice_parameters_suggest_their_choices():
     assert params.getRangeSuggestion("nearest_policy") == "euclidean,exhausted,exhaustion"
 
 
-def test_balance_tree_sizes_is_swap_policy_balance_nodes():
-    planner = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation())
-    params = planner.params()
-    assert params.getParam("swap_policy") == "balance_nodes" and params.getParam("balance_tree_sizes") == "1"
-    assert params.setParam("balance_tree_sizes", "0")
-    assert params.getParam("swap_policy") == "alternate"
-    assert params.setParam("swap_policy", "balance_nodes")
-    assert params.getParam("balance_tree_sizes") == "1"
-    assert params.setParam("swap_policy", "on_collision")
-    assert params.getParam("balance_tree_sizes") == "0"
-    assert params.setParam("balance_tree_sizes", "0")  # already not balancing: the policy stays
-    assert params.getParam("swap_policy") == "on_collision"
-    assert params.setParam("balance_tree_sizes", "1")
-    assert params.getParam("swap_policy") == "balance_nodes"
+def test_balance_tree_sizes_and_swap_policy_are_independent_in_any_order():
+    """No parameter is an alias of another: a dict of settings gives one planner whatever its order."""
+    values = {"swap_policy": "on_collision", "balance_tree_sizes": "1", "max_tree_size_ratio": "0.5"}
+    planners_made = []
+    for order in (list(values), list(reversed(values))):
+        planner = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation())
+        assert planner.params().setParams({key: values[key] for key in order})
+        planners_made.append(planner.params().getParams())
+    assert planners_made[0] == planners_made[1]
+    assert planners_made[0]["swap_policy"] == "on_collision" and planners_made[0]["balance_tree_sizes"] == "1"
+
+
+def test_a_presets_policy_changes_only_through_its_own_parameter():
+    planner = PRESETS["CollisionSwapRRTConnect"](get_problem("open").setup().getSpaceInformation())
+    assert planner.getBalanceTreeSizes() is False and planner.getSwapPolicy() == "on_collision"
+    assert planner.params().setParam("balance_tree_sizes", "1")
+    assert planner.getSwapPolicy() == "on_collision"  # balancing joins the preset's rule, not replaces it
 
 
 def test_valid_sampler_with_a_fixed_seed_is_refused_at_setup():

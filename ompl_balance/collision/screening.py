@@ -5,9 +5,9 @@ obstacle, or two link geometries enabled for self-collision — is screened with
 bounding volumes that contain what FCL tests:
 
 * each link geometry is covered by one sphere and, inside it, by ``k`` smaller spheres
-  (:meth:`~ompl_balance.geometry.Shape.bounding_spheres`);
+  (:meth:`~ompl_balance.collision.geometry.Shape.bounding_spheres`);
 * each obstacle is contained in an oriented box
-  (:meth:`~ompl_balance.geometry.Shape.bounding_box`).
+  (:meth:`~ompl_balance.collision.geometry.Shape.bounding_box`).
 
 A pair is *cleared* when its big spheres are apart, or when no small sphere of one
 touches the other's volume; only pairs that are not cleared go on to FCL.
@@ -80,7 +80,7 @@ class Volumes(NamedTuple):
 
 
 def build_volumes(robot, obstacles, spheres_per_geometry: int) -> Volumes:
-    """:class:`Volumes` for ``robot`` (a :class:`~ompl_balance.kinematics.RobotModel`)
+    """:class:`Volumes` for ``robot`` (a :class:`~ompl_balance.collision.kinematics.RobotModel`)
     among ``obstacles`` (:class:`~ompl_balance.validity.Obstacle` list)."""
     geometries = robot.geometries
     tables = _free_tables(robot)
@@ -201,7 +201,7 @@ def _free_tables(robot) -> dict[str, np.ndarray]:
     """The ``Volumes`` fields of the certified-free tables of ``robot``'s self-collision pairs.
 
     A fraction of a second per table: computed once per robot and process, and kept in
-    the disk cache (:mod:`ompl_balance.cache`) under everything they are computed from.
+    the disk cache (:mod:`ompl_balance.collision.cache`) under everything they are computed from.
     """
     if robot not in _TABLES_OF:
         key = [*robot.chain, robot.lower, robot.upper, np.array(robot.self_collision_pairs),
@@ -339,7 +339,7 @@ def warm_up() -> None:
     """Compile the kernels, or load them from numba's cache, for the argument types every
     robot's checker uses (a robot with no geometry stands in): about half a second,
     spent here instead of in a robot's first check. The benchmark runner's forkserver
-    does this once (:mod:`ompl_balance.warm_kernels`), so run processes start warm."""
+    does this once (:mod:`ompl_balance.collision.warm_kernels`), so run processes start warm."""
     integers, reals = (lambda *shape: np.zeros(shape, dtype=np.int64)), (lambda *shape: np.zeros(shape))
     chain = Chain(integers(1), reals(1), reals(1), integers(1), reals(1, 3, 3), reals(1, 3, 3), reals(1, 3, 3),
                   reals(1, 3), reals(1, 3), reals(1, 3))

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from importlib import metadata
+from importlib import metadata, resources
 from pathlib import Path
 
 from .kinematics import RobotModel
@@ -37,11 +37,17 @@ def load_example_robot_data_panda() -> RobotModel:
                                 package_map={"example-robot-data": str(share)})
 
 
-def load_panda_vamp(directory) -> RobotModel:
-    """VAMP's Panda (the model the MotionBenchMaker problems were made for) from ``directory``.
+#: VAMP's Panda as shipped with the package (URDF, SRDF, collision meshes; Apache-2.0).
+PANDA_VAMP_DIR = Path(str(resources.files("ompl_balance") / "data" / "panda_vamp"))
 
-    ``directory`` holds ``panda.urdf``, ``panda.srdf`` and ``meshes/collision/*.obj``, as
-    in VAMP's ``resources/panda``; the fingers are fixed open at 0.065 m, so 7 joints.
+
+def load_panda_vamp(directory: str | Path | None = None) -> RobotModel:
+    """VAMP's Panda, the model the MotionBenchMaker problems were made for.
+
+    By default the copy shipped with the package (:data:`PANDA_VAMP_DIR`); ``directory``
+    may name another folder of the same layout: ``panda.urdf``, ``panda.srdf`` and
+    ``meshes/collision/*.obj``, as in VAMP's ``resources/panda``. The fingers are fixed
+    open at 0.065 m, so 7 joints.
     """
-    directory = Path(directory)
+    directory = PANDA_VAMP_DIR if directory is None else Path(directory)
     return RobotModel.from_urdf(directory / "panda.urdf", directory / "panda.srdf")

@@ -1,4 +1,4 @@
-"""Importing this module compiles the collision kernels (:func:`ompl_balance.screening.warm_up`).
+"""Importing this module compiles the collision kernels (:func:`ompl_balance.collision.screening.warm_up`).
 
 The benchmark runner's forkserver imports it with the robot layer, so that every run
 process forked from it starts with the kernels ready instead of loading them (about

@@ -3,21 +3,42 @@
 One file per scenario: joint names, and per problem a start, one or more goals
 (any goal is a success) and the obstacles (boxes with half extents, cylinders along
 local z with full length, spheres; world frame = robot base). The problems were made
-for VAMP's Panda model (:func:`ompl_balance.robots.load_panda_vamp`).
+for VAMP's Panda model (:func:`ompl_balance.collision.robots.load_panda_vamp`).
+
+The package ships four scenarios of MotionBenchMaker's Panda set, 100 problems each
+(:data:`SCENARIOS`); :func:`load_mbm` takes their names or a file of the same schema.
 """
 
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from .kinematics import RobotModel
-from .validity import CollisionChecker, Environment, setup_robot, space_for
+from ..collision.checker import CollisionChecker, Environment
+from ..collision.kinematics import RobotModel
+from ..validity import setup_robot, space_for
+
+
+#: The scenarios shipped with the package (``data/mbm/panda/<name>.json``).
+SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small")
+MBM_DIR = Path(str(resources.files("ompl_balance") / "data" / "mbm" / "panda"))
+
+
+def scenario_path(scenario: str | Path) -> Path:
+    """The file of a shipped scenario (``"box"``), or ``scenario`` itself when it is a path."""
+    if str(scenario) in SCENARIOS:
+        return MBM_DIR / f"{scenario}.json"
+    path = Path(scenario)
+    if not path.is_file():
+        raise ValueError(f"{str(scenario)!r} is neither a shipped MotionBenchMaker scenario "
+                         f"({', '.join(SCENARIOS)}) nor a file")
+    return path
 
 
 @dataclass(frozen=True)
@@ -52,13 +73,14 @@ class MBMProblem:
         return ss
 
 
-def load_mbm(path, joint_names: list[str] | None = None) -> list[MBMProblem]:
-    """Read a scenario file; configurations reordered to ``joint_names`` (default: the file's order).
+def load_mbm(scenario: str | Path, joint_names: list[str] | None = None) -> list[MBMProblem]:
+    """The problems of a scenario: a shipped one by name (:data:`SCENARIOS`) or a JSON file.
 
-    Raises ``ValueError`` naming the file, problem and field for anything missing or malformed,
+    Configurations are reordered to ``joint_names`` (default: the file's order). Raises
+    ``ValueError`` naming the file, problem and field for anything missing or malformed,
     and for joint names the file and ``joint_names`` do not share.
     """
-    path = Path(path)
+    path = scenario_path(scenario)
     try:
         data = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as error:

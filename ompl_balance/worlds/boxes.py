@@ -1,7 +1,7 @@
 """Built-in planning problems: 2-D worlds of axis-aligned boxes in the unit square.
 
 Each :class:`Problem` builds a fresh ``og.SimpleSetup`` whose state validity checker
-counts the states it checks (:class:`~ompl_balance.counting.CountingValidityChecker`),
+counts the states it checks (:class:`~ompl_balance.core.counting.CountingValidityChecker`),
 so stock OMPL planners and this package's planners are measured alike.
 
 =============  ===============================================================
@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from ompl import base as ob
 from ompl import geometric as og
 
-from .counting import CountingValidityChecker
+from ..core.counting import CountingValidityChecker
 
 Box = tuple[float, float, float, float]  # x_min, y_min, x_max, y_max
 

@@ -1,6 +1,6 @@
 """Tree storage and exact nearest neighbour for the planners.
 
-Two stores with one interface, chosen by :mod:`ompl_balance.spaces`:
+Two stores with one interface (:class:`Tree`), chosen by :mod:`ompl_balance.core.spaces`:
 
 :class:`ArrayTree`
     real-vector states in one contiguous ``(capacity, dim)`` float64 array grown by
@@ -16,11 +16,34 @@ a path is read off by following parents. Node ``i`` is the ``i``-th state added.
 from __future__ import annotations
 
 import math
+from types import ModuleType
+from typing import Any, Protocol
 
 import numpy as np
 from ompl import base as ob
 
 NO_PARENT = -1
+
+
+class Tree(Protocol):
+    """What planners ask of a tree: nodes with parents and roots, and exact neighbour queries.
+
+    Points are ``(dim,)`` arrays (:class:`ArrayTree`) or OMPL states (:class:`StateTree`).
+    """
+
+    parents: np.ndarray  # (capacity,) parent index per node, NO_PARENT for a root
+
+    def __len__(self) -> int: ...
+    def state(self, index: int) -> Any: ...
+    def add(self, state: Any, parent: int = NO_PARENT) -> int: ...
+    def parent(self, index: int) -> int: ...
+    def root(self, index: int) -> int: ...
+    def branch(self, index: int) -> list[int]: ...
+    def reparent(self, subtree: np.ndarray, parent: int) -> None: ...
+    def nearest(self, state: Any) -> tuple[int, float]: ...
+    def near(self, state: Any, radius: float) -> tuple[np.ndarray, np.ndarray]: ...
+    def distances(self, state: Any) -> np.ndarray: ...
+    def clear(self) -> None: ...
 
 
 class _Links:
@@ -70,8 +93,8 @@ class _Links:
         self.size = 0
 
 
-def load_scans():
-    """The compiled nearest/near scans (:mod:`ompl_balance.scans`).
+def load_scans() -> ModuleType:
+    """The compiled nearest/near scans (:mod:`ompl_balance.core.scans`).
 
     The first call imports numba and loads the kernels (about half a second, once per
     process); planners call it from ``setup()`` so that no solve pays it.

@@ -21,10 +21,11 @@ from pathlib import Path
 import numpy as np
 from ompl import base as ob
 
-from .benchmark import experiment_records
+from .compare import experiment_records
 from .experiment import Experiment
-from .planners import GOAL_TAG, START_TAG, BalancedRRTConnect
-from .problems import PROBLEMS
+from ..core.planner import GOAL_TAG, START_TAG
+from ..planners import BalancedRRTConnect
+from ..worlds.boxes import PROBLEMS
 from .runner import Record, ResultStore
 from .summary import format_csv, format_markdown, pooled_by_scenario, summarize
 

@@ -1,11 +1,11 @@
 """Compiled scans over a tree's states: the nearest node, and the nodes within a radius.
 
 Both read the rows ``states[:size]`` of a C-contiguous ``(capacity, dim)`` float64
-array (:class:`~ompl_balance.trees.ArrayTree`'s storage) and compare squared
+array (:class:`~ompl_balance.core.trees.ArrayTree`'s storage) and compare squared
 Euclidean distances exactly, one row at a time. Compiled with numba for one fixed
 signature, so a process compiles (or loads from numba's cache) each kernel once, at
 import; importing this module therefore takes about half a second the first time in
-a process, which is why :mod:`ompl_balance.trees` imports it on first use.
+a process, which is why :mod:`ompl_balance.core.trees` imports it on first use.
 """
 
 import math

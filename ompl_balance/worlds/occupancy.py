@@ -8,13 +8,11 @@ covers ``x in [x0 + col * res, x0 + (col + 1) * res)`` and
 :func:`rooms_grid` is a 40 m x 40 m floor plan: six rooms off a corridor, doors placed
 so that the way from the start (bottom-left room) to the goal (top-right room) winds
 through the corridor, with more than one route. :func:`rooms_problem` poses it in
-R^2 (``"rooms"``) or SE(2) (``"rooms_se2"``, a point robot with a free heading), and
-:func:`gamma_command` is the ``ompl-balance gamma`` subcommand.
+R^2 (``"rooms"``) or SE(2) (``"rooms_se2"``, a point robot with a free heading).
 """
 
 from __future__ import annotations
 
-import argparse
 import math
 from dataclasses import dataclass
 
@@ -22,7 +20,6 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from .gamma import ball_radius_constant, estimate_free_measure, ompl_rewire_factor, rewire_radius
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,7 +90,7 @@ class GridValidityChecker(ob.StateValidityChecker):
     The state's position is ``(s[0], s[1])`` in a real-vector space (further
     coordinates are ignored) or ``(s.getX(), s.getY())`` in SE(2). A state is valid
     when its position lies in a free cell. ``counters()`` follows
-    :mod:`ompl_balance.counting`.
+    :mod:`ompl_balance.core.counting`.
     """
 
     def __init__(self, si: ob.SpaceInformation, grid: OccupancyGrid) -> None:
@@ -220,73 +217,3 @@ def rooms_problem(se2: bool = False) -> OccupancyProblem:
 
 
 OCCUPANCY_PROBLEMS = {"rooms": lambda: rooms_problem(se2=False), "rooms_se2": lambda: rooms_problem(se2=True)}
-
-
-def gamma_command(argv: list[str]) -> int:
-    """``ompl-balance gamma``: print the ball-radius constant for a problem; returns the exit code."""
-    parser = argparse.ArgumentParser(
-        prog="ompl-balance gamma",
-        description=(
-            "Estimate RRT*'s ball-radius constant gamma* = 2^d (1 + 1/d) mu(X_free) / zeta_d "
-            "(Karaman & Frazzoli 2011) for a built-in problem or an occupancy grid you give, "
-            "and the rewire_factor that makes OMPL's RRTstar use the same radius schedule."
-        ),
-    )
-    source = parser.add_mutually_exclusive_group()
-    source.add_argument(
-        "--problem",
-        default="rooms",
-        help="built-in problem: rooms, rooms_se2 (occupancy grid, counted exactly) or a box world of "
-        "'ompl-balance compare' (open, narrow_gap, bug_trap, maze; Monte Carlo). Default: rooms",
-    )
-    source.add_argument("--grid", metavar="FILE.npy", help="a 2-D boolean occupancy array (True = occupied) saved with numpy.save")
-    parser.add_argument("--resolution", type=float, default=0.2, help="cell side of --grid in metres (default 0.2)")
-    parser.add_argument("--samples", type=int, default=20000, help="Monte Carlo samples when the measure is estimated (default 20000)")
-    parser.add_argument("--confidence", type=float, default=0.95, help="confidence level of the interval (default 0.95)")
-    parser.add_argument("--monte-carlo", action="store_true", help="estimate by sampling even when a grid allows exact counting")
-    parser.add_argument("--seed", type=int, default=None, help="seed of the Monte Carlo samples")
-    parser.add_argument("--eta", type=float, default=0.0, help="maximum connection distance for the radius table (default 0.2 x extent)")
-    args = parser.parse_args(argv)
-
-    if args.grid is not None:
-        try:
-            occupied = np.load(args.grid)
-            grid = OccupancyGrid(occupied, args.resolution)
-        except (OSError, ValueError) as error:
-            parser.error(f"--grid {args.grid}: {error}")
-        problem_name = args.grid
-        ss = OccupancyProblem(args.grid, grid, grid.low, grid.high).setup()
-    elif args.problem in OCCUPANCY_PROBLEMS:
-        problem_name, problem = args.problem, OCCUPANCY_PROBLEMS[args.problem]()
-        grid, ss = problem.grid, problem.setup()
-    else:
-        from .problems import PROBLEMS  # the box worlds have no grid: Monte Carlo only
-
-        if args.problem not in PROBLEMS:
-            parser.error(f"unknown problem {args.problem!r}; built-in problems: {', '.join([*OCCUPANCY_PROBLEMS, *PROBLEMS])}")
-        problem_name, grid, ss = args.problem, None, PROBLEMS[args.problem].setup()
-
-    si = ss.getSpaceInformation()
-    try:
-        free = estimate_free_measure(
-            si, samples=args.samples, confidence=args.confidence, grid=None if args.monte_carlo else grid, rng=args.seed
-        )
-    except ValueError as error:
-        parser.error(str(error))
-    d = si.getStateDimension()
-    gamma = ball_radius_constant(d, free.high)
-    eta = args.eta if args.eta > 0 else 0.2 * si.getMaximumExtent()
-    print(f"problem            {problem_name} ({si.getStateSpace().getName()}, d = {d})")
-    print(f"space measure      {free.space_measure:.6g}")
-    if free.exact:
-        print(f"free measure       {free.measure:.6g} (exact, {free.free_fraction:.2%} of the space, from the grid cells)")
-    else:
-        print(
-            f"free measure       {free.measure:.6g}, {free.confidence:.0%} interval [{free.low:.6g}, {free.high:.6g}] "
-            f"({free.samples} samples, {free.free_fraction:.2%} free)"
-        )
-    print(f"gamma*             {gamma:.6g}  (from the {'exact' if free.exact else 'upper'} free measure)")
-    print(f"OMPL rewire_factor {ompl_rewire_factor(si, gamma):.6g}  (RRTstar, setKNearest(False), range = eta)")
-    for n in (100, 1000, 10000):
-        print(f"radius at N={n:<6} {rewire_radius(n, d, gamma, eta):.4g}  (gamma = 100: {rewire_radius(n, d, 100.0, eta):.4g}; eta = {eta:.4g})")
-    return 0

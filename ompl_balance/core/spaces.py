@@ -7,11 +7,11 @@ them. Two implementations share one interface:
     for ``ob.RealVectorStateSpace``: points are numpy arrays of shape ``(dim,)``,
     sampled uniformly within the bounds from a numpy generator, with Euclidean
     distance and straight-line interpolation (what OMPL's real-vector space does);
-    trees are :class:`~ompl_balance.trees.ArrayTree`.
+    trees are :class:`~ompl_balance.core.trees.ArrayTree`.
 :class:`StatePoints`
     for every other OMPL space (SO2, SE2, SE3, compound, ...): points are OMPL states,
     and every question goes to OMPL (``si.distance``, ``space.interpolate``, the
-    space's default sampler); trees are :class:`~ompl_balance.trees.StateTree`.
+    space's default sampler); trees are :class:`~ompl_balance.core.trees.StateTree`.
 
 Collision checking is never done here: planners pass ``ompl_state(point)`` to
 ``si.isValid`` / ``si.checkMotion`` so that stock OMPL planners and ours use exactly the
@@ -21,14 +21,31 @@ same checker and motion validator.
 from __future__ import annotations
 
 import math
+from typing import Any, Protocol
 
 import numpy as np
 from ompl import base as ob
 
-from .trees import ArrayTree, StateTree, load_scans
+from .trees import ArrayTree, StateTree, Tree, load_scans
 
 _SAMPLE_BLOCK = 256  # uniform samples drawn from numpy at a time
 _EQUAL_TOLERANCE = 2.0 * float(np.finfo(float).eps)
+
+
+class Points(Protocol):
+    """How a planner sees the points of a state space (both classes below implement it)."""
+
+    def new_tree(self) -> Tree: ...
+    def sample(self) -> Any: ...
+    def distance(self, a: Any, b: Any) -> float: ...
+    def interpolate(self, a: Any, b: Any, t: float) -> Any: ...
+    def equal(self, a: Any, b: Any) -> bool: ...
+    def may_stall(self, step: float) -> bool: ...
+    def is_finite(self, state: ob.State) -> bool: ...
+    def from_state(self, state: ob.State) -> Any: ...
+    def ompl_state(self, point: Any, slot: int = 0) -> ob.State: ...
+    def new_state(self, point: Any) -> ob.State: ...
+    def segment_points(self, a: Any, b: Any) -> list[Any]: ...
 
 
 class RealVectorPoints:
@@ -174,13 +191,13 @@ def _is_real_vector(si: ob.SpaceInformation) -> bool:
     return type(si.getStateSpace()) is ob.RealVectorStateSpace
 
 
-def points_for(si: ob.SpaceInformation, rng: np.random.Generator) -> RealVectorPoints | StatePoints:
+def points_for(si: ob.SpaceInformation, rng: np.random.Generator) -> Points:
     """The fast array view for plain real-vector spaces, OMPL states otherwise."""
     return RealVectorPoints(si, rng) if _is_real_vector(si) else StatePoints(si)
 
 
 def prepare(si: ob.SpaceInformation) -> None:
     """One-time work a planner's ``setup()`` does so that ``solve()`` does not: for
-    real-vector spaces, load the compiled tree scans (:func:`~ompl_balance.trees.load_scans`)."""
+    real-vector spaces, load the compiled tree scans (:func:`~ompl_balance.core.trees.load_scans`)."""
     if _is_real_vector(si):
         load_scans()

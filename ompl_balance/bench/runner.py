@@ -4,7 +4,7 @@ Every run executes in a fresh process forked from a ``forkserver`` that has impo
 OMPL and this package once (a few milliseconds per run, not a new interpreter). The
 fresh process matters twice: OMPL's global ``RNG.setSeed`` only works before the first
 random number of a process, so each run seeds it with its own seed
-(:func:`~ompl_balance.experiment.run_seed`) and stock planners repeat too; and a run
+(:func:`~ompl_balance.bench.experiment.run_seed`) and stock planners repeat too; and a run
 that segfaults, aborts or ignores its time limit takes only its own process down. The
 parent waits at most ``task.hard_limit`` seconds (2 x the time limit + a margin:
 planning, then simplification bounded by the time limit) and records ``CRASH`` or
@@ -37,7 +37,7 @@ from typing import Any
 from ompl import base as ob
 from ompl import util as ou
 
-from .counting import measured_solve
+from ..core.counting import measured_solve
 from .experiment import Experiment, RunTask, planner_params
 
 #: OMPL's planner status names -> the index the OMPL log's ``status`` enum uses.
@@ -164,8 +164,8 @@ def _child(task: RunTask, connection) -> None:
 # -- around the run's process -----------------------------------------------------------
 
 # "__main__" too: a run's process then need not re-import the main script (spawn semantics)
-_PRELOAD = ["__main__", "ompl_balance.runner", "ompl_balance.scans"]
-_ROBOT_PRELOAD = ["ompl_balance.mbm", "ompl_balance.robots", "ompl_balance.validity", "ompl_balance.warm_kernels"]
+_PRELOAD = ["__main__", "ompl_balance.bench.runner", "ompl_balance.core.scans"]
+_ROBOT_PRELOAD = ["ompl_balance.worlds.mbm", "ompl_balance.collision.robots", "ompl_balance.validity", "ompl_balance.collision.warm_kernels"]
 
 
 def preload_modules(experiment: Experiment) -> list[str]:

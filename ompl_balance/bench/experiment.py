@@ -12,12 +12,14 @@ Experiments come from TOML files (:func:`load_experiment`) or from Python::
     baseline = "RRTConnect"    # planner label the summary's ratios refer to
 
     [[problems]]
-    builtin = "narrow_gap"                     # ompl_balance.problems.PROBLEMS
+    builtin = "narrow_gap"                     # ompl_balance.worlds.boxes.PROBLEMS
 
     [[problems]]
-    mbm = "data/mbm/panda/table_pick.json"     # MotionBenchMaker scenario (relative to this file)
-    robot = "data/robots/panda_vamp"           # folder with panda.urdf + panda.srdf (VAMP layout)
+    mbm = "table_pick"                         # a shipped MotionBenchMaker scenario, or a JSON file
+                                               # (relative to this file)
     ids = [1, 2, "10-19"]                      # problem ids; default: all
+    # robot = "my/panda_vamp"                  # another folder with panda.urdf + panda.srdf
+                                               # (default: the Panda shipped with the package)
 
     [[problems]]
     factory = "mypackage.worlds:make_setup"    # function(**args) -> og.SimpleSetup
@@ -55,9 +57,10 @@ from typing import Any
 from ompl import base as ob
 from ompl import geometric as og
 
-from . import planners as package_planners
-from .counting import ensure_counting
-from .problems import PROBLEMS
+from ..core.counting import ensure_counting
+from ..planners import PRESETS
+from ..rrtstar import BallRadiusRRTstar
+from ..worlds.boxes import PROBLEMS
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -82,11 +85,7 @@ class ExperimentError(ValueError):
 
 def package_planner_classes() -> dict[str, type[ob.Planner]]:
     """This package's planners by name: ``BalancedRRTConnect``, ``BallRadiusRRTstar`` and the presets."""
-    classes = {"BalancedRRTConnect": package_planners.BalancedRRTConnect}
-    if hasattr(package_planners, "BallRadiusRRTstar"):
-        classes["BallRadiusRRTstar"] = package_planners.BallRadiusRRTstar
-    classes.update(getattr(package_planners, "PRESETS", {}))
-    return classes
+    return {**PRESETS, "BallRadiusRRTstar": BallRadiusRRTstar}
 
 
 def stock_planner_classes() -> dict[str, type[ob.Planner]]:
@@ -240,9 +239,9 @@ class PlannerSpec:
 class ProblemSpec:
     """A problem of the experiment; :meth:`build` makes its ``og.SimpleSetup``.
 
-    ``kind`` is ``"builtin"`` (``source`` names one of ``ompl_balance.problems.PROBLEMS``),
-    ``"mbm"`` (``source`` is a MotionBenchMaker JSON file, ``problem_id`` the problem's
-    id and ``robot`` the robot folder) or ``"factory"`` (``source`` is
+    ``kind`` is ``"builtin"`` (``source`` names one of ``ompl_balance.worlds.boxes.PROBLEMS``),
+    ``"mbm"`` (``source`` is a shipped MotionBenchMaker scenario or a JSON file,
+    ``problem_id`` the problem's id and ``robot`` the robot folder, empty for the shipped Panda) or ``"factory"`` (``source`` is
     ``"module:function"`` called with ``args``). ``name`` is unique in the experiment
     and names its log file.
     """
@@ -275,10 +274,10 @@ class ProblemSpec:
 
 def _mbm_setup(path: str, problem_id: int, robot_dir: str) -> og.SimpleSetup:
     """A MotionBenchMaker problem on VAMP's Panda layout: batched checker, all goals as ``GoalStates``."""
-    from .mbm import load_mbm
-    from .robots import load_panda_vamp
+    from ..collision.robots import load_panda_vamp
+    from ..worlds.mbm import load_mbm
 
-    robot = load_panda_vamp(robot_dir)
+    robot = load_panda_vamp(robot_dir or None)
     problem = next(p for p in load_mbm(path, robot.joint_names) if p.id == problem_id)
     return problem.simple_setup(robot)
 
@@ -493,24 +492,28 @@ def _problems(table: Mapping[str, Any], index: int, base_dir: Path) -> list[Prob
 
 
 def _mbm_problems(table: Mapping[str, Any], where: str, base_dir: Path) -> list[ProblemSpec]:
-    from .mbm import load_mbm
+    from ..worlds.mbm import SCENARIOS, load_mbm
 
-    path = (base_dir / table["mbm"]).resolve()
-    if not path.is_file():
-        raise ExperimentError(f"{where}.mbm", f"no such file {str(path)!r}", table["mbm"])
-    if "robot" not in table:
-        raise ExperimentError(f"{where}.robot", "an mbm problem needs the robot folder (panda.urdf, panda.srdf)")
-    robot = (base_dir / table["robot"]).resolve()
-    if not (robot / "panda.urdf").is_file():
-        raise ExperimentError(f"{where}.robot", f"no panda.urdf in {str(robot)!r}", table["robot"])
+    source = str(table["mbm"])
+    if source not in SCENARIOS:  # a file, relative to the experiment file
+        path = (base_dir / source).resolve()
+        if not path.is_file():
+            raise ExperimentError(f"{where}.mbm", f"{source!r} is neither a shipped scenario ({', '.join(SCENARIOS)}) "
+                                                  f"nor a file (looked for {str(path)!r})", table["mbm"])
+        source = str(path)
+    robot = ""  # the Panda shipped with the package
+    if "robot" in table:
+        robot = str((base_dir / table["robot"]).resolve())
+        if not (Path(robot) / "panda.urdf").is_file():
+            raise ExperimentError(f"{where}.robot", f"no panda.urdf in {robot!r}", table["robot"])
     try:
-        scenario = load_mbm(path)
+        scenario = load_mbm(source)
     except ValueError as error:
         raise ExperimentError(f"{where}.mbm", str(error), table["mbm"]) from error
     available = [problem.id for problem in scenario]
     ids = _ids(table.get("ids", "all"), available, f"{where}.ids")
-    name = scenario[0].scenario if scenario else path.stem
-    return [ProblemSpec(f"{name}.{i:03d}", "mbm", str(path), problem_id=i, robot=str(robot)) for i in ids]
+    name = scenario[0].scenario if scenario else Path(source).stem
+    return [ProblemSpec(f"{name}.{i:03d}", "mbm", source, problem_id=i, robot=robot) for i in ids]
 
 
 def _ids(selection: Any, available: list[int], where: str) -> list[int]:

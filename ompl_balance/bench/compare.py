@@ -1,7 +1,7 @@
 """Benchmarks: run an experiment into an output folder; ``compare`` is a ready-made experiment.
 
-:func:`bench` executes an :class:`~ompl_balance.experiment.Experiment` (each run in its
-own process, see :mod:`ompl_balance.runner`) and keeps everything in one folder::
+:func:`bench` executes an :class:`~ompl_balance.bench.experiment.Experiment` (each run in its
+own process, see :mod:`ompl_balance.bench.runner`) and keeps everything in one folder::
 
     OUT/experiment.json     the experiment (a later run of the same experiment resumes)
     OUT/results.jsonl       one record per finished run, appended as runs finish
@@ -24,8 +24,8 @@ from pathlib import Path
 from tqdm import tqdm
 
 from .experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec
-from .ompl_log import to_database, write_logs
-from .problems import PROBLEMS
+from .logs import to_database, write_logs
+from ..worlds.boxes import PROBLEMS
 from .runner import Progress, Record, ResultStore, sweep
 from .summary import format_csv, format_markdown, summarize
 

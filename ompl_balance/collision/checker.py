@@ -1,0 +1,265 @@
+"""Exact collision checking of a URDF robot among static obstacles, batched over configurations.
+
+:class:`CollisionChecker` answers "is this configuration collision-free?" for a
+:class:`~ompl_balance.collision.kinematics.RobotModel` among the obstacles of an
+:class:`Environment`, for many configurations at once:
+
+1. forward kinematics and a conservative screening, compiled, for all configurations
+   in one call (:mod:`ompl_balance.collision.screening`): spheres covering each link
+   geometry against an oriented box around each obstacle, and against each other for the
+   self-collision pairs; only the pairs it cannot clear go on to
+2. FCL's exact test, pair by pair, on FCL objects built once (only their transforms
+   are updated).
+
+The answer is FCL's: the screening only skips pairs whose bounding volumes are
+apart, which FCL would report free. ``prefilter=False`` skips the screening and checks the
+environment through FCL's broad phase (a dynamic AABB tree of the obstacles against
+one of the robot's geometries) and every self-collision pair with FCL; it is the
+straightforward reference the tests compare with.
+
+The checker counts what it checks in its :class:`WorkCounter`, which the OMPL adapters
+(:mod:`ompl_balance.validity`) share (see :mod:`ompl_balance.core.counting`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import fcl
+import numba
+import numpy as np
+import trimesh
+
+from .geometry import Shape, fcl_transform, pose_matrix
+from .kinematics import RobotModel
+from .screening import build_volumes, screen
+
+
+@dataclass(frozen=True, eq=False)
+class Obstacle:
+    """A static obstacle: ``shape`` at world ``pose`` (4, 4)."""
+
+    name: str
+    shape: Shape
+    pose: np.ndarray
+
+
+class Environment:
+    """The static obstacles around a robot, in the robot's base (world) frame, metres.
+
+    Poses are given as ``position`` (3,) of the shape's centre and a unit quaternion
+    ``orientation_xyzw`` (scalar last), rotating shape axes into the world.
+    """
+
+    def __init__(self):
+        self.obstacles: list[Obstacle] = []
+
+    def add(self, name: str, shape: Shape, position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+        if any(o.name == name for o in self.obstacles):
+            raise ValueError(f"environment already has an obstacle named {name!r}")
+        try:
+            pose = pose_matrix(position, orientation_xyzw)
+        except ValueError as error:
+            raise ValueError(f"obstacle {name!r}: {error}") from error
+        self.obstacles.append(Obstacle(name, shape, pose))
+
+    def add_box(self, name: str, half_extents, position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+        """A box with ``half_extents`` (hx, hy, hz), half the edge lengths."""
+        self.add(name, Shape.box(half_extents), position, orientation_xyzw)
+
+    def add_sphere(self, name: str, radius: float, position=(0.0, 0.0, 0.0)) -> None:
+        self.add(name, Shape.sphere(radius), position)
+
+    def add_cylinder(self, name: str, radius: float, length: float, position=(0.0, 0.0, 0.0),
+                     orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+        """A cylinder along its local z, ``length`` the full height, centred on ``position``."""
+        self.add(name, Shape.cylinder(radius, length), position, orientation_xyzw)
+
+    def add_mesh(self, name: str, mesh, position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+        """A triangle mesh: a ``trimesh.Trimesh`` or a file trimesh can read."""
+        if not isinstance(mesh, trimesh.Trimesh):
+            try:
+                mesh = trimesh.load(str(mesh), force="mesh")
+            except Exception as error:
+                raise ValueError(f"obstacle {name!r}: cannot read mesh {mesh}: {error}") from error
+        self.add(name, Shape.from_mesh(mesh), position, orientation_xyzw)
+
+
+class WorkCounter:
+    """States and motions checked; one instance is shared by a checker and its motion validator."""
+
+    def __init__(self):
+        self.states_checked = 0
+        self.motions_checked = 0
+
+    def counters(self) -> dict[str, int]:
+        return {"states_checked": self.states_checked, "motions_checked": self.motions_checked}
+
+    def reset(self) -> None:
+        self.states_checked = 0
+        self.motions_checked = 0
+
+
+class CollisionChecker:
+    """Exact collision checks of a robot among static obstacles, batched over configurations.
+
+    Parameters
+    ----------
+    robot:
+        The robot; its ``self_collision_pairs`` are checked for self-collision.
+    environment:
+        The obstacles (none if omitted).
+    spheres_per_geometry:
+        How many small spheres cover each link geometry in the screening (tighter with
+        more; see :mod:`ompl_balance.collision.screening`).
+    prefilter:
+        ``False`` checks every pair with FCL (through FCL's broad phase for the environment).
+    """
+
+    def __init__(self, robot: RobotModel, environment: Environment | None = None,
+                 spheres_per_geometry: int = 8, prefilter: bool = True):
+        self.robot = robot
+        self.environment = environment or Environment()
+        self.prefilter = prefilter
+        self.counter = WorkCounter()
+        geometries, obstacles = robot.geometries, self.environment.obstacles
+        self._request = fcl.CollisionRequest()
+
+        self._geometry_origin = np.array([g.origin for g in geometries]).reshape(-1, 4, 4)
+        self._origin_is_identity = [bool(np.array_equal(g.origin, np.eye(4))) for g in geometries]
+        self._links = [fcl.CollisionObject(g.shape.fcl_geometry(), fcl.Transform()) for g in geometries]
+        self._obstacles = [fcl.CollisionObject(o.shape.fcl_geometry(), fcl_transform(o.pose)) for o in obstacles]
+        self._pairs = robot.self_collision_pairs  # (a, b) geometry indices
+        self._environment_manager = fcl.DynamicAABBTreeCollisionManager()
+        self._environment_manager.registerObjects(self._obstacles)
+        self._environment_manager.setup()
+
+        self._volumes = build_volumes(robot, obstacles, spheres_per_geometry)
+        # The screening kernel is called without numba's type dispatch (about 4 us of a
+        # 30 us state check): the argument types are fixed here, and _screen passes
+        # C-contiguous float rows and fresh output arrays. The single-state path (OMPL's
+        # isValid) reuses its output arrays.
+        self._one = self._screen_outputs(1)
+        arguments = (np.zeros((1, robot.dof)), robot.chain, self._volumes, *self._one)
+        screen(*arguments)  # compile or load the kernel now, not in a solve
+        self._kernel = screen.overloads[tuple(numba.typeof(a) for a in arguments)].entry_point
+
+    # ------------------------------------------------------------------ public API
+
+    def check(self, q) -> np.ndarray:
+        """Validity (collision-free) of each configuration: ``q`` (n, dof) or (dof,) -> bool (n,)."""
+        q = self.robot.as_array(q)
+        self.counter.states_checked += len(q)
+        if not self.prefilter:
+            return np.array([self._free_reference(p) for p in self.robot.body_poses(q)], dtype=bool)
+        outputs = self._screen_outputs(len(q))
+        maybe = self._screen(q, outputs)
+        poses, obstacle_hits, self_hits = outputs
+        valid = ~maybe
+        for i in np.flatnonzero(maybe):
+            valid[i] = self._free_exact(poses[i], obstacle_hits[i], self_hits[i])
+        return valid
+
+    def is_valid(self, q) -> bool:
+        """Validity of one configuration ``q`` (dof,)."""
+        q = self.robot.as_array(q)
+        if len(q) != 1:
+            raise ValueError(f"is_valid takes one configuration of {self.robot.dof} joint values, got shape {q.shape}")
+        self.counter.states_checked += 1
+        if not self.prefilter:
+            return self._free_reference(self.robot.body_poses(q)[0])
+        poses, obstacle_hits, self_hits = self._one
+        return not self._screen(q, self._one)[0] or self._free_exact(poses[0], obstacle_hits[0], self_hits[0])
+
+    def first_collision(self, q, order=None, first_chunk: int = 1) -> int:
+        """Index of the first configuration in collision, visiting ``q`` (n, dof) in ``order``, or -1.
+
+        The first ``first_chunk`` rows of ``order`` (default: row order) go through
+        forward kinematics and the screening together, then the rest together; the exact
+        tests run row by row in ``order`` and stop at the first collision. Rows of a chunk
+        that was processed count as states checked.
+        """
+        q = self.robot.as_array(q)
+        order = np.arange(len(q)) if order is None else np.asarray(order, dtype=int)
+        for chunk in (order[:first_chunk], order[first_chunk:]):
+            if len(chunk) == 0:
+                continue
+            self.counter.states_checked += len(chunk)
+            if not self.prefilter:
+                poses = self.robot.body_poses(q[chunk])
+                hit = next((k for k in range(len(chunk)) if not self._free_reference(poses[k])), -1)
+            else:
+                outputs = self._screen_outputs(len(chunk))
+                maybe = self._screen(q[chunk], outputs)
+                poses, obstacle_hits, self_hits = outputs
+                hit = next((k for k in np.flatnonzero(maybe)
+                            if not self._free_exact(poses[k], obstacle_hits[k], self_hits[k])), -1)
+            if hit >= 0:
+                return int(chunk[hit])
+        return -1
+
+    def counters(self) -> dict[str, int]:
+        return self.counter.counters()
+
+    def reset_counters(self) -> None:
+        self.counter.reset()
+
+    # ------------------------------------------------------------------ internals
+
+    def _screen_outputs(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Arrays :func:`~ompl_balance.collision.screening.screen` fills for ``n`` configurations:
+        body poses, obstacle-geometry hits and self-pair hits."""
+        return (np.empty((n, self.robot.body_count, 4, 4)),
+                np.empty((n, len(self._obstacles), len(self._links)), dtype=bool),
+                np.empty((n, len(self._pairs)), dtype=bool))
+
+    def _screen(self, q: np.ndarray, outputs) -> np.ndarray:
+        """Screen ``q`` (n, dof) into ``outputs`` (from :meth:`_screen_outputs`); True where FCL must decide."""
+        return self._kernel(np.ascontiguousarray(q), self.robot.chain, self._volumes, *outputs)
+
+    def _place(self, body_poses: np.ndarray, geometry: int) -> None:
+        """Move the FCL object of ``geometry`` to its pose for one configuration."""
+        pose = body_poses[self._volumes.geometry_body[geometry]]
+        if not self._origin_is_identity[geometry]:
+            pose = pose.dot(self._geometry_origin[geometry])
+        self._links[geometry].setRotation(pose[:3, :3])
+        self._links[geometry].setTranslation(pose[:3, 3])
+
+    def _collide(self, a: fcl.CollisionObject, b: fcl.CollisionObject) -> bool:
+        return fcl.collide(a, b, self._request, fcl.CollisionResult()) > 0
+
+    def _free_exact(self, body_poses: np.ndarray, obstacle_hits: np.ndarray, self_hits: np.ndarray) -> bool:
+        """FCL on the pairs the screening did not clear in one configuration; True if none collides.
+
+        ``body_poses`` (bodies, 4, 4), ``obstacle_hits`` (obstacles, geometries) and
+        ``self_hits`` (pairs) as filled by :meth:`_screen`.
+        """
+        placed = set()
+
+        def place(geometry):
+            if geometry not in placed:
+                self._place(body_poses, geometry)
+                placed.add(geometry)
+
+        for o, g in zip(*np.nonzero(obstacle_hits)):
+            place(g)
+            if self._collide(self._links[g], self._obstacles[o]):
+                return False
+        for p in np.flatnonzero(self_hits):
+            a, b = self._pairs[p]
+            place(a)
+            place(b)
+            if self._collide(self._links[a], self._links[b]):
+                return False
+        return True
+
+    def _free_reference(self, body_poses: np.ndarray) -> bool:
+        """FCL without pre-filter: broad phase against the environment, then every self pair."""
+        for g in range(len(self._links)):
+            self._place(body_poses, g)
+        for link in self._links:
+            data = fcl.CollisionData(self._request, fcl.CollisionResult())
+            self._environment_manager.collide(link, data, fcl.defaultCollisionCallback)
+            if data.result.is_collision:
+                return False
+        return not any(self._collide(self._links[a], self._links[b]) for a, b in self._pairs)

@@ -1,0 +1,335 @@
+"""RRT* whose rewiring ball follows a settable ball-radius constant ``gamma``.
+
+The radius schedule is ``min((gamma log N / N)^(1/d), eta)`` (:func:`~ompl_balance.gamma.rewire_radius`),
+as in MATLAB's ``plannerRRTStar`` and its example "Calculating an Appropriate
+BallRadiusConstant for plannerRRTStar"; :mod:`ompl_balance.gamma` estimates ``gamma`` for a
+problem. The loop is OMPL's ``RRTstar`` (``src/ompl/geometric/planners/rrt/src/RRTstar.cpp``,
+radius mode, delayed collision checking).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+from ompl import base as ob
+from ompl import util as ou
+
+from .core.params import Settings, param
+from .core.planner import RANGE_AS_EXTENT_FRACTION, START_TAG, TreePlanner
+from .core.spaces import Points
+from .core.trees import NO_PARENT, Tree
+from .gamma import estimate_ball_radius_constant, rewire_radius
+
+#: Monte Carlo samples used to estimate the free measure when ``ball_radius_constant`` is ``auto``.
+AUTO_GAMMA_SAMPLES = 5000
+
+
+@dataclass
+class RRTstarSettings(Settings):
+    """The parameters of :class:`BallRadiusRRTstar`, named as in MATLAB's ``plannerRRTStar``."""
+
+    max_connection_distance: float = param(
+        0.0, "eta: longest motion added in one step, and the cap of the rewiring radius (state-space distance); "
+        "0 picks 0.2 x the space's maximum extent at setup()", low=0.0, suggestion="0.:1.:10000.")
+    ball_radius_constant: float | str = param(
+        "auto", "gamma (distance^d); auto estimates gamma* for the problem's free space at setup() "
+        f"(ompl_balance.gamma.estimate_ball_radius_constant, {AUTO_GAMMA_SAMPLES} validity checks, not counted "
+        "in the solve's stats)", kind=float, low=0.0, low_open=True, words=("auto",), suggestion="1.:1.:1000000.")
+    goal_bias: float = param(0.05, "probability of sampling the goal region instead of the space",
+                             low=0.0, high=1.0, suggestion="0.:.05:1.")
+    continue_after_goal_reached: bool = param(
+        True, "keep improving the path after the first one until the termination condition, an iteration or "
+        "node limit, or a satisfied cost threshold; false stops at the first path (MATLAB's default)")
+    max_iterations: int = param(10000, "iterations per solve(); 0: no limit", low=0, suggestion="0:1000:1000000")
+    max_nodes: int = param(10000, "stop once the tree has this many nodes; 0: no limit", low=0,
+                           suggestion="0:1000:1000000")
+    seed: int = param(0, "as BalancedRRTConnect's seed (numpy sampling in real-vector spaces)", low=0,
+                      suggestion="0:1:1000000")
+
+
+@dataclass
+class RRTstarStats:
+    """The work one ``BallRadiusRRTstar.solve()`` did, and how the best cost evolved.
+
+    Attributes
+    ----------
+    status: the ``PlannerStatus`` as a string.
+    iterations: main-loop iterations (one sample each) in this solve.
+    tree_size: nodes in the tree when the solve ended (cumulative until ``clear()``).
+    best_cost: cost of the best path to the goal (path length), ``inf`` if none.
+    first_solution_iteration: iteration (1-based, this solve) that found the first
+        path, ``None`` if none was found or a path existed before this solve.
+    ball_radius_constant: the ``gamma`` used (estimated at setup in ``auto`` mode).
+    rewires: tree nodes given a cheaper parent through a new node.
+    states_checked, motions_checked: as in :class:`~ompl_balance.planners.RunStats`.
+    time: wall-clock seconds spent in ``solve()``.
+    best_costs: ``(iterations,)`` best cost after each iteration, ``inf`` before the
+        first path; never increases.
+    """
+
+    status: str
+    iterations: int
+    tree_size: int
+    best_cost: float
+    first_solution_iteration: int | None
+    ball_radius_constant: float
+    rewires: int
+    states_checked: int
+    motions_checked: int
+    time: float
+    best_costs: np.ndarray = field(repr=False)
+
+    def as_dict(self) -> dict[str, float | int | str | None]:
+        """The scalar fields (``best_costs`` left out)."""
+        return {key: value for key, value in asdict(self).items() if key != "best_costs"}
+
+
+def path_length_objective(pdef: ob.ProblemDefinition, si: ob.SpaceInformation) -> ob.OptimizationObjective:
+    """The problem's path-length objective, or a new one set on ``pdef`` when it has none.
+
+    As OMPL's ``RRTstar::setup``. Any other objective is refused with ``ValueError``:
+    the planner's costs are distances (``si.distance``), exactly path length.
+    """
+    if not pdef.hasOptimizationObjective():
+        objective = ob.PathLengthOptimizationObjective(si)
+        pdef.setOptimizationObjective(objective)
+        return objective
+    objective = pdef.getOptimizationObjective()
+    if not isinstance(objective, ob.PathLengthOptimizationObjective):
+        raise ValueError(
+            f"BallRadiusRRTstar optimises path length only; the problem's objective is {type(objective).__name__} "
+            "(use ob.PathLengthOptimizationObjective, optionally with a cost threshold, or none)"
+        )
+    return objective
+
+
+class CostTree:
+    """RRT*'s tree: nodes with their cost-to-come, children lists, and the nodes in the goal."""
+
+    def __init__(self, tree: Tree) -> None:
+        self.tree = tree
+        self.costs = np.empty(0)  # cost-to-come of each node
+        self.children: list[list[int]] = []
+        self.goal_nodes: list[int] = []
+
+    def __len__(self) -> int:
+        return len(self.tree)
+
+    def add(self, point: Any, parent: int, cost: float) -> int:
+        """Add ``point`` under ``parent`` with cost-to-come ``cost``; return its index."""
+        index = self.tree.add(point, parent)
+        if index == len(self.costs):
+            self.costs = np.concatenate([self.costs, np.empty(max(index, 1024))])
+        self.costs[index] = cost
+        self.children.append([])
+        if parent != NO_PARENT:
+            self.children[parent].append(index)
+        return index
+
+    def rewire(self, node: int, parent: int, cost: float) -> None:
+        """Make ``parent`` the parent of ``node``, whose cost-to-come becomes ``cost``."""
+        children = self.children
+        children[self.tree.parent(node)].remove(node)
+        children[parent].append(node)
+        members = [node]
+        for member in members:  # grows while iterated: breadth-first through the subtree
+            members.extend(children[member])
+        subtree = np.fromiter(members, dtype=np.int64, count=len(members))
+        self.tree.reparent(subtree, parent)
+        self.costs[subtree] += cost - self.costs[node]
+
+    def best_cost(self) -> float:
+        return float(self.costs[self.goal_nodes].min()) if self.goal_nodes else math.inf
+
+    def best_branch(self) -> list[int]:
+        """Nodes from the root to the cheapest goal node."""
+        best_goal = self.goal_nodes[int(self.costs[self.goal_nodes].argmin())]
+        return list(reversed(self.tree.branch(best_goal)))
+
+
+class BallRadiusRRTstar(TreePlanner):
+    """RRT* whose rewiring ball follows ``min((gamma log N / N)^(1/d), eta)`` with a settable ``gamma``.
+
+    Parameters are those of :class:`RRTstarSettings`, through ``planner.params()`` or the
+    camelCase accessors; :meth:`getBallRadiusConstantInUse` tells the ``gamma`` of the next
+    solve (the estimate, in ``auto`` mode).
+
+    As OMPL's ``RRTstar`` (radius mode, delayed collision checking): the new state's
+    parent is the neighbour giving the cheapest valid path, candidates checked in
+    order of cost; then every neighbour a path through the new state would make
+    cheaper is rewired, and its subtree's costs updated. ``N`` is the tree size
+    counting the new state. The run stops early when the problem's objective is
+    satisfied by the best cost (``objective.isSatisfied``, e.g. a cost threshold).
+
+    Differences from stock, on purpose: no approximate solutions (``TIMEOUT`` without
+    a path); no pruning or informed sampling; only the path-length objective;
+    ``plannerData()`` instead of ``getPlannerData``; each solve reports an
+    :class:`RRTstarStats` (``planner.stats``).
+    """
+
+    Settings = RRTstarSettings
+    Stats = RRTstarStats
+
+    def __init__(self, si: ob.SpaceInformation, name: str | None = None) -> None:
+        super().__init__(si, name)
+        self._estimated_gamma: float | None = None
+        self._tree: CostTree | None = None
+
+    def getBallRadiusConstantInUse(self) -> float | None:  # noqa: N802
+        """The ``gamma`` the next solve uses; ``None`` in ``auto`` mode before ``setup()``."""
+        gamma = self.settings.ball_radius_constant
+        return self._estimated_gamma if gamma == "auto" else float(gamma)
+
+    # -- planner life cycle -------------------------------------------------------
+
+    def setup(self) -> None:
+        super().setup()
+        settings = self.settings
+        if settings.max_connection_distance < 1e-12:
+            settings.max_connection_distance = RANGE_AS_EXTENT_FRACTION * self.getSpaceInformation().getMaximumExtent()
+            ou.OMPL_INFORM(f"{self.getName()}: max_connection_distance computed to be {settings.max_connection_distance:g}")
+        if settings.ball_radius_constant == "auto":
+            self._estimated_gamma = self._estimate_gamma()
+
+    def _estimate_gamma(self) -> float:
+        seed = self.settings.seed or self._draw_seed()
+        gamma = estimate_ball_radius_constant(self.getSpaceInformation(), samples=AUTO_GAMMA_SAMPLES, rng=seed)
+        ou.OMPL_INFORM(f"{self.getName()}: ball_radius_constant estimated to be {gamma:g}")
+        return gamma
+
+    def clear(self) -> None:
+        super().clear()
+        self._tree = None
+
+    # -- solving -------------------------------------------------------------------
+
+    def _before_solve(self) -> None:
+        path_length_objective(self.getProblemDefinition(), self.getSpaceInformation())
+        if self.getBallRadiusConstantInUse() is None:
+            self._estimated_gamma = self._estimate_gamma()
+
+    def _plan(
+        self, ptc: ob.PlannerTerminationCondition, points: Points, rng: np.random.Generator
+    ) -> tuple[ob.PlannerStatus.PlannerStatusType, dict[str, Any]]:
+        """The RRT* loop; returns the status and the loop's statistics."""
+        name, settings = self.getName(), self.settings
+        si = self.getSpaceInformation()
+        pdef = self.getProblemDefinition()  # keep the owner alive while its states are used
+        objective, goal = pdef.getOptimizationObjective(), pdef.getGoal()
+        gamma = self.getBallRadiusConstantInUse()
+        assert gamma is not None
+        if self._tree is None:
+            self._tree = CostTree(points.new_tree())
+        nodes = self._tree
+        tree = nodes.tree
+        best_before = nodes.best_cost()
+        improvements: list[tuple[int, float]] = []  # (iteration, new best cost)
+        iterations = rewires = 0
+
+        def result(status: ob.PlannerStatus.PlannerStatusType) -> tuple[Any, dict[str, Any]]:
+            best_costs = np.full(iterations, best_before)
+            for iteration, cost in improvements:
+                best_costs[iteration - 1 :] = cost
+            first = improvements[0][0] if improvements and math.isinf(best_before) else None
+            return status, dict(iterations=iterations, tree_size=len(nodes), best_cost=nodes.best_cost(),
+                                first_solution_iteration=first, ball_radius_constant=gamma, rewires=rewires,
+                                best_costs=best_costs)
+
+        inputs = self.getPlannerInputStates()
+        while (state := inputs.nextStart()) is not None:
+            if not points.is_finite(state):
+                ou.OMPL_WARN(f"{name}: Skipping start state with non-finite values")
+                continue
+            root = nodes.add(points.from_state(state), NO_PARENT, 0.0)
+            if goal.isSatisfied(state):
+                nodes.goal_nodes.append(root)
+        if len(tree) == 0:
+            ou.OMPL_ERROR(f"{name}: There are no valid initial states!")
+            return result(ob.PlannerStatus.INVALID_START)
+        sampleable = goal if isinstance(goal, ob.GoalSampleableRegion) else None
+        goal_sample = si.allocState()
+        ou.OMPL_INFORM(f"{name}: Starting planning with {len(tree)} states already in datastructure")
+
+        check_motion, is_goal, ompl_state = si.checkMotion, goal.isSatisfied, points.ompl_state
+        d, eta = si.getStateDimension(), settings.max_connection_distance
+        max_iterations, max_nodes = settings.max_iterations or math.inf, settings.max_nodes or math.inf
+        best = nodes.best_cost()
+        while not ptc() and iterations < max_iterations and len(tree) < max_nodes:
+            iterations += 1
+            if (
+                sampleable is not None
+                and len(nodes.goal_nodes) < sampleable.maxSampleCount()
+                and rng.random() < settings.goal_bias
+            ):
+                sampleable.sampleGoal(goal_sample)
+                if not points.is_finite(goal_sample):
+                    continue
+                target = points.from_state(goal_sample)
+            else:
+                target = points.sample()
+
+            nearest, distance = tree.nearest(target)
+            if distance == 0.0:
+                continue  # the sample is a tree node already
+            near_point = tree.state(nearest)
+            new = target if distance <= eta else points.interpolate(near_point, target, eta / distance)
+            new_state = ompl_state(new, 1)  # written once: every check below uses it
+            if not check_motion(ompl_state(near_point, 0), new_state):
+                continue
+
+            # Parent: the neighbour giving the cheapest valid path, checked in order of cost.
+            neighbours, distances = tree.near(new, rewire_radius(len(tree) + 1, d, gamma, eta))
+            costs = nodes.costs
+            through = costs[neighbours] + distances
+            parent, cost = nearest, costs[nearest] + min(distance, eta)
+            valid = {nearest: True}  # neighbour -> whether its motion to the new state is valid
+            for i in through.argsort().tolist():
+                if through[i] >= cost:
+                    break
+                neighbour = int(neighbours[i])
+                valid[neighbour] = check_motion(ompl_state(tree.state(neighbour), 0), new_state)
+                if valid[neighbour]:
+                    parent, cost = neighbour, float(through[i])
+                    break
+            added = nodes.add(new, parent, cost)
+            found_goal = is_goal(new_state)
+            if found_goal:
+                nodes.goal_nodes.append(added)
+
+            # Rewire: neighbours reached more cheaply through the new state.
+            costs = nodes.costs
+            rewired = False
+            for i in np.flatnonzero(cost + distances < costs[neighbours]).tolist():
+                neighbour, through_new = int(neighbours[i]), cost + distances[i]
+                if not through_new < costs[neighbour]:
+                    continue  # an earlier rewire in this loop made it cheaper already
+                if neighbour not in valid:
+                    valid[neighbour] = check_motion(new_state, ompl_state(tree.state(neighbour), 0))
+                if valid[neighbour]:
+                    nodes.rewire(neighbour, added, through_new)
+                    rewires += 1
+                    rewired = True
+
+            if (found_goal or rewired) and nodes.goal_nodes:
+                candidate = nodes.best_cost()
+                if candidate < best:
+                    best = candidate
+                    improvements.append((iterations, best))
+                    if not settings.continue_after_goal_reached or objective.isSatisfied(ob.Cost(best)):
+                        break
+
+        if nodes.goal_nodes:
+            self._add_solution(points, [tree.state(node) for node in nodes.best_branch()])
+            status = ob.PlannerStatus.EXACT_SOLUTION
+        else:
+            status = ob.PlannerStatus.TIMEOUT
+        ou.OMPL_INFORM(f"{name}: Created {len(tree)} states, {rewires} rewires; best cost {best:.4g}")
+        return result(status)
+
+    def _fill_planner_data(self, data: ob.PlannerData, points: Points, keep_alive: list[ob.State]) -> None:
+        """The tree, tag 1: roots are start vertices, goal nodes goal vertices; edges parent -> child."""
+        if self._tree is not None:
+            self._add_tree(data, points, self._tree.tree, START_TAG, keep_alive, goal_nodes=self._tree.goal_nodes)
