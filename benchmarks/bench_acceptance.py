@@ -27,7 +27,7 @@ from ompl import util as ou
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from acceptance import (  # noqa: E402 (the harness lives with the tests)
+from acceptance import (
     MACHINE_SPEED_FACTOR,
     MAP_RUNS,
     STOCK,
@@ -37,7 +37,7 @@ from acceptance import (  # noqa: E402 (the harness lives with the tests)
     run_2d_circles_test,
     run_2d_map_test,
 )
-from ompl_envs import RESOURCES, Circles2D, load_circles, load_environment, load_queries  # noqa: E402
+from ompl_envs import RESOURCES, Circles2D, load_circles, load_environment, load_queries
 
 
 class TimedCircles(Circles2D):

@@ -24,10 +24,10 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect
-from ompl_balance.core.counting import measured_solve
-from ompl_balance.worlds.mbm import load_mbm
 from ompl_balance.collision.robots import load_panda_vamp
+from ompl_balance.core.counting import measured_solve
 from ompl_balance.validity import CollisionChecker
+from ompl_balance.worlds.mbm import load_mbm
 
 SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small")
 PLANNERS = {"RRTConnect": og.RRTConnect, "BalancedRRTConnect": BalancedRRTConnect}
@@ -42,10 +42,15 @@ def solve(robot, problem, make_planner, time_limit: float) -> dict:
     if run.solved:
         path = ss.getSolutionPath()
         path.interpolate()  # states at the space's validity-checking resolution
-        states = np.array([path.getState(i)[0:robot.dof] for i in range(path.getStateCount())])
+        states = np.array([path.getState(i)[0 : robot.dof] for i in range(path.getStateCount())])
         path_valid = bool(CollisionChecker(robot, problem.environment).check(states).all())
-    return {"solved": run.solved, "time": run.time, "checks": run.work.states_checked,
-            "motions": run.work.motions_checked, "path_valid": path_valid}
+    return {
+        "solved": run.solved,
+        "time": run.time,
+        "checks": run.work.states_checked,
+        "motions": run.work.motions_checked,
+        "path_valid": path_valid,
+    }
 
 
 def main() -> None:
@@ -54,16 +59,22 @@ def main() -> None:
     parser.add_argument("--data", type=Path, default=repo.parent / "shared" / "data")
     parser.add_argument("--problems", type=int, default=10, help="first N problems of each scenario (default 10)")
     parser.add_argument("--time-limit", type=float, default=10.0, help="seconds per run (default 10)")
-    parser.add_argument("--scenarios", default=",".join(SCENARIOS), help="comma-separated subset of " + ", ".join(SCENARIOS))
+    parser.add_argument(
+        "--scenarios", default=",".join(SCENARIOS), help="comma-separated subset of " + ", ".join(SCENARIOS)
+    )
     args = parser.parse_args()
     ou.RNG.setSeed(1)
     ou.setLogLevel(ou.LOG_WARN)
     robot = load_panda_vamp(args.data / "robots" / "panda_vamp")
 
-    print(f"Panda (VAMP model), first {args.problems} problems per scenario, one run each, time limit "
-          f"{args.time_limit:g} s; ratios are to stock RRTConnect's medians\n")
-    print("| scenario | planner | success | median time (ms) | median states checked | median motions "
-          "| time ratio | checks ratio |")
+    print(
+        f"Panda (VAMP model), first {args.problems} problems per scenario, one run each, time limit "
+        f"{args.time_limit:g} s; ratios are to stock RRTConnect's medians\n"
+    )
+    print(
+        "| scenario | planner | success | median time (ms) | median states checked | median motions "
+        "| time ratio | checks ratio |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for scenario in args.scenarios.split(","):
         problems = load_mbm(args.data / "mbm" / "panda" / f"{scenario}.json", robot.joint_names)[: args.problems]
@@ -74,14 +85,19 @@ def main() -> None:
                 if result["path_valid"] is False:
                     raise AssertionError(f"{scenario} problem {problem.id}: {name} returned a path in collision")
                 results[name].append(result)
-        medians = {name: {key: statistics.median(r[key] for r in runs) for key in ("time", "checks", "motions")}
-                   for name, runs in results.items()}
+        medians = {
+            name: {key: statistics.median(r[key] for r in runs) for key in ("time", "checks", "motions")}
+            for name, runs in results.items()
+        }
         stock = medians["RRTConnect"]
         for name, runs in results.items():
             m = medians[name]
             success = sum(r["solved"] for r in runs) / len(runs)
-            print(f"| {scenario} | {name} | {success:.0%} | {m['time'] * 1e3:.0f} | {m['checks']:.0f} | {m['motions']:.0f} "
-                  f"| {m['time'] / stock['time']:.2f} | {m['checks'] / max(stock['checks'], 1):.2f} |", flush=True)
+            print(
+                f"| {scenario} | {name} | {success:.0%} | {m['time'] * 1e3:.0f} | {m['checks']:.0f} | {m['motions']:.0f} "
+                f"| {m['time'] / stock['time']:.2f} | {m['checks'] / max(stock['checks'], 1):.2f} |",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

@@ -92,20 +92,29 @@ def run(make_setup, make_planner, time_limit: float) -> dict:
     ss = make_setup()
     ss.setPlanner(make_planner(ss.getSpaceInformation()))
     run = measured_solve(ss, time_limit)
-    return {"solved": run.solved, "time": run.time, "checks": run.work.states_checked, "motions": run.work.motions_checked}
+    return {
+        "solved": run.solved,
+        "time": run.time,
+        "checks": run.work.states_checked,
+        "motions": run.work.motions_checked,
+    }
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=30, help="runs per planner and problem (default 30)")
     parser.add_argument("--time-limit", type=float, default=30.0, help="seconds per run (default 30)")
-    parser.add_argument("--problems", default=",".join(PROBLEMS), help="comma-separated subset of " + ", ".join(PROBLEMS))
+    parser.add_argument(
+        "--problems", default=",".join(PROBLEMS), help="comma-separated subset of " + ", ".join(PROBLEMS)
+    )
     args = parser.parse_args()
     ou.RNG.setSeed(1)
     ou.setLogLevel(ou.LOG_WARN)
 
     print(f"{args.runs} runs per cell, time limit {args.time_limit:g} s; ratios are to stock RRTConnect's medians\n")
-    print("| problem | planner | success | median time (ms) | median checks | median motions | time ratio | checks ratio | time per motion ratio |")
+    print(
+        "| problem | planner | success | median time (ms) | median checks | median motions | time ratio | checks ratio | time per motion ratio |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for problem in args.problems.split(","):
         results = {name: [] for name in PLANNERS}

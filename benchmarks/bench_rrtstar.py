@@ -29,8 +29,8 @@ from ompl import util as ou
 
 from ompl_balance.core.counting import read_work
 from ompl_balance.gamma import ball_radius_constant, ompl_rewire_factor
-from ompl_balance.worlds.occupancy import OccupancyGrid, OccupancyProblem, rooms_problem
 from ompl_balance.planners import BallRadiusRRTstar
+from ompl_balance.worlds.occupancy import OccupancyGrid, OccupancyProblem, rooms_problem
 
 
 class PaddedGridChecker(ob.StateValidityChecker):
@@ -41,7 +41,7 @@ class PaddedGridChecker(ob.StateValidityChecker):
         self._grid, self._cost_ns = grid, cost_ns
         self.states_checked = 0
 
-    def isValid(self, state) -> bool:  # noqa: N802
+    def isValid(self, state) -> bool:
         self.states_checked += 1
         deadline = time.perf_counter_ns() + self._cost_ns
         while time.perf_counter_ns() < deadline:
@@ -59,7 +59,9 @@ def padded_setup(problem: OccupancyProblem, cost_ns: int) -> og.SimpleSetup:
     return ss
 
 
-def run(kind: str, problem: OccupancyProblem, gamma: float, eta: float, cost_ns: int, iterations: int, seconds: float) -> dict:
+def run(
+    kind: str, problem: OccupancyProblem, gamma: float, eta: float, cost_ns: int, iterations: int, seconds: float
+) -> dict:
     """One run of ``kind`` ("ours"/"stock") stopped after ``iterations`` (if > 0) or ``seconds``."""
     ss = padded_setup(problem, cost_ns)
     si = ss.getSpaceInformation()
@@ -134,7 +136,9 @@ def main() -> None:
         records = equal_time[kind]
         rows[kind] = (median(records, "iterations"), median(records, "cost"))
         print(f"{kind:10}{rows[kind][0]:12.0f}{rows[kind][1]:12.2f}")
-    print(f"{'ratio':10}{rows['ours'][0] / rows['stock'][0]:12.2f}{rows['ours'][1] / rows['stock'][1]:12.3f}   (ours / stock)")
+    print(
+        f"{'ratio':10}{rows['ours'][0] / rows['stock'][0]:12.2f}{rows['ours'][1] / rows['stock'][1]:12.3f}   (ours / stock)"
+    )
 
 
 if __name__ == "__main__":

@@ -25,15 +25,15 @@ import fcl
 import numpy as np
 from ompl import base as ob
 
-from ompl_balance.worlds.mbm import load_mbm
 from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.validity import CollisionChecker, StateValidityChecker, setup_robot, space_for
+from ompl_balance.worlds.mbm import load_mbm
 
 
 def straightforward_body_poses(robot, q):
     """Body poses (n, bodies, 4, 4) by plain batched numpy FK: the package's first FK, kept
     here unchanged so that the baseline does not speed up with the package."""
-    joints = robot._joints  # noqa: SLF001 (the model's own joint list)
+    joints = robot._joints
     source = np.array([j.source for j in joints])
     values = q[:, source] * np.array([j.multiplier for j in joints]) + np.array([j.shift for j in joints])
     axis = np.array([j.axis for j in joints])
@@ -41,7 +41,7 @@ def straightforward_body_poses(robot, q):
     zero = np.zeros_like(x)
     cross = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1).reshape(-1, 3, 3)
     revolute = np.array([j.kind == "revolute" for j in joints], dtype=float)[:, None, None]
-    motion = np.broadcast_to(np.eye(4), values.shape + (4, 4)).copy()
+    motion = np.broadcast_to(np.eye(4), (*values.shape, 4, 4)).copy()
     s, c = np.sin(values)[..., None, None], np.cos(values)[..., None, None]
     motion[..., :3, :3] += revolute * (s * cross + (1.0 - c) * (cross @ cross))
     motion[..., :3, 3] += (1.0 - revolute[:, :, 0]) * values[..., None] * axis
@@ -62,8 +62,10 @@ class BaselineChecker:
         self.robot_manager = fcl.DynamicAABBTreeCollisionManager()
         self.robot_manager.registerObjects(self.links)
         self.robot_manager.setup()
-        self.obstacles = [fcl.CollisionObject(o.shape.fcl_geometry(), fcl.Transform(o.pose[:3, :3], o.pose[:3, 3]))
-                          for o in environment.obstacles]
+        self.obstacles = [
+            fcl.CollisionObject(o.shape.fcl_geometry(), fcl.Transform(o.pose[:3, :3], o.pose[:3, 3]))
+            for o in environment.obstacles
+        ]
         self.environment_manager = fcl.DynamicAABBTreeCollisionManager()
         self.environment_manager.registerObjects(self.obstacles)
         self.environment_manager.setup()
@@ -80,8 +82,9 @@ class BaselineChecker:
         self.robot_manager.collide(self.environment_manager, data, fcl.defaultCollisionCallback)
         if data.result.is_collision:
             return False
-        return not any(fcl.collide(self.links[a], self.links[b], self.request, fcl.CollisionResult())
-                       for a, b in self.pairs)
+        return not any(
+            fcl.collide(self.links[a], self.links[b], self.request, fcl.CollisionResult()) for a, b in self.pairs
+        )
 
 
 def timed(function, *args):
@@ -114,7 +117,7 @@ def bench_scene(robot, problem, states, edge_count, rng):
 
     space = space_for(robot)
     si_package = ob.SpaceInformation(space)
-    validity, motion = setup_robot(si_package, checker)
+    validity, _motion = setup_robot(si_package, checker)
     si_package.setup()
     si_discrete = ob.SpaceInformation(space)  # OMPL's default DiscreteMotionValidator
     si_discrete.setStateValidityChecker(StateValidityChecker(si_discrete, checker))
@@ -126,20 +129,21 @@ def bench_scene(robot, problem, states, edge_count, rng):
     expected, single, batched = [], [], []
     t_base = t_single = t_batch = 0.0
     for chunk in np.array_split(q, max(1, states // 20)):
-        answers, elapsed = timed(lambda: [baseline.is_valid(x) for x in chunk])
+        answers, elapsed = timed(lambda chunk=chunk: [baseline.is_valid(x) for x in chunk])
         expected += answers
         t_base += elapsed
         for state, x in zip(chunk_states, chunk):
             space.copyFromReals(state, list(x))
-        answers, elapsed = timed(lambda: [validity.isValid(state) for state in chunk_states[:len(chunk)]])
+        answers, elapsed = timed(lambda chunk=chunk: [validity.isValid(state) for state in chunk_states[: len(chunk)]])
         single += answers
         t_single += elapsed
         answers, elapsed = timed(checker.check, chunk)
         batched += list(answers)
         t_batch += elapsed
     expected = np.array(expected)
-    assert (np.array(single) == expected).all() and (np.array(batched) == expected).all(), \
+    assert (np.array(single) == expected).all() and (np.array(batched) == expected).all(), (
         "package checker disagrees with the baseline"
+    )
 
     length = 0.2 * space.getMaximumExtent()  # RRT-Connect's default range
     edges = random_edges(robot, checker, edge_count, length, rng)
@@ -188,13 +192,19 @@ def main():
         rows.append(row)
         print(f"table_pick {problem.id}: " + ", ".join(f"{k} {v:.3g}" for k, v in row.items()), flush=True)
     median = {k: float(np.median([r[k] for r in rows])) for k in rows[0]}
-    print(f"\nPanda (VAMP model, {len(robot.self_collision_pairs)} self-collision pairs), "
-          f"{len(problems)} table_pick scenes, {args.states} random states and {args.edges} edges each; medians:")
-    print(f"  states: baseline {median['baseline_us']:.0f} us/state; package one by one {median['single_us']:.0f} us "
-          f"({median['single_speedup']:.2f}x), in batches of 20 {median['batch_us']:.0f} us ({median['batch_speedup']:.2f}x); "
-          f"target >= 5x and <= 40 us")
-    print(f"  edges vs OMPL discrete validator: free {median['edge_speedup_free']:.2f}x, colliding "
-          f"{median['edge_speedup_colliding']:.2f}x, all {median['edge_speedup_all']:.2f}x; target >= 2x")
+    print(
+        f"\nPanda (VAMP model, {len(robot.self_collision_pairs)} self-collision pairs), "
+        f"{len(problems)} table_pick scenes, {args.states} random states and {args.edges} edges each; medians:"
+    )
+    print(
+        f"  states: baseline {median['baseline_us']:.0f} us/state; package one by one {median['single_us']:.0f} us "
+        f"({median['single_speedup']:.2f}x), in batches of 20 {median['batch_us']:.0f} us ({median['batch_speedup']:.2f}x); "
+        f"target >= 5x and <= 40 us"
+    )
+    print(
+        f"  edges vs OMPL discrete validator: free {median['edge_speedup_free']:.2f}x, colliding "
+        f"{median['edge_speedup_colliding']:.2f}x, all {median['edge_speedup_all']:.2f}x; target >= 2x"
+    )
 
 
 if __name__ == "__main__":

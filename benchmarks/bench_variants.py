@@ -56,7 +56,7 @@ SAME_BAND = 0.1
 
 
 def effect(ratio: float) -> str:
-    """"fewer", "same" or "more" (collision queries than the reference)."""
+    """ "fewer", "same" or "more" (collision queries than the reference)."""
     if ratio < 1 - SAME_BAND:
         return "fewer"
     return "more" if ratio > 1 + SAME_BAND else "same"
@@ -64,9 +64,9 @@ def effect(ratio: float) -> str:
 
 def mbm_problems(count: int) -> dict:
     """``name -> make_setup`` for the first ``count`` problems of each Panda scenario."""
-    from ompl_balance.worlds.mbm import load_mbm
     from ompl_balance.collision.robots import load_panda_vamp
     from ompl_balance.validity import CollisionChecker
+    from ompl_balance.worlds.mbm import load_mbm
 
     robot = load_panda_vamp(DATA / "robots" / "panda_vamp")
     problems = {}
@@ -102,9 +102,13 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=20, help="runs per planner and problem (default 20)")
     parser.add_argument("--time-limit", type=float, default=10.0, help="seconds per run (default 10)")
     parser.add_argument(
-        "--problems", default=",".join(PROBLEMS), help="2-D problems: comma-separated subset of " + ", ".join(PROBLEMS) + " ('' for none)"
+        "--problems",
+        default=",".join(PROBLEMS),
+        help="2-D problems: comma-separated subset of " + ", ".join(PROBLEMS) + " ('' for none)",
     )
-    parser.add_argument("--mbm", type=int, default=0, help="also the first N problems of each MBM Panda scenario (default 0)")
+    parser.add_argument(
+        "--mbm", type=int, default=0, help="also the first N problems of each MBM Panda scenario (default 0)"
+    )
     args = parser.parse_args()
     ou.RNG.setSeed(1)
     ou.setLogLevel(ou.LOG_NONE)
@@ -117,8 +121,10 @@ def main() -> None:
             print(f"(no MotionBenchMaker data at {DATA / 'mbm' / 'panda'}: Panda problems skipped)\n")
 
     print(f"{args.runs} runs per cell, time limit {args.time_limit:g} s; ratios are to stock RRTConnect's medians\n")
-    print("| problem | planner | success | median time (ms) | median collision queries | median nodes "
-          "| time ratio | queries ratio | nodes ratio |")
+    print(
+        "| problem | planner | success | median time (ms) | median collision queries | median nodes "
+        "| time ratio | queries ratio | nodes ratio |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     query_ratios: dict[str, dict[str, float]] = {name: {} for name in PLANNERS}
     for problem, make_setup in problems.items():

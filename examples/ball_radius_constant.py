@@ -27,14 +27,14 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
-import numpy as np  # noqa: E402
-from ompl import util as ou  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.collections import LineCollection
+from ompl import util as ou
 
-from ompl_balance.gamma import ball_radius_constant, estimate_ball_radius_constant, rewire_radius, unit_ball_volume  # noqa: E402
-from ompl_balance.worlds.occupancy import OccupancyProblem, rooms_problem  # noqa: E402
-from ompl_balance.planners import BallRadiusRRTstar  # noqa: E402
+from ompl_balance.gamma import ball_radius_constant, estimate_ball_radius_constant, rewire_radius, unit_ball_volume
+from ompl_balance.planners import BallRadiusRRTstar
+from ompl_balance.worlds.occupancy import OccupancyProblem, rooms_problem
 
 ETA = 4.0  # m, maximum connection distance on the rooms map
 
@@ -63,7 +63,9 @@ def plot_radius_and_neighbours_by_gamma(out: Path, eta: float = 0.1, free_measur
         radii = rewire_radius(counts, d, gamma, eta)
         radius_ax.plot(counts, radii, label=f"gamma = {gamma:g}")
         count_ax.plot(counts, counts * unit_ball_volume(d) * radii**d / free_measure, label=f"gamma = {gamma:g}")
-    radius_ax.set(xscale="log", yscale="log", xlabel="tree nodes N", ylabel="radius", title=f"RRT* radius, d = 3, eta = {eta}")
+    radius_ax.set(
+        xscale="log", yscale="log", xlabel="tree nodes N", ylabel="radius", title=f"RRT* radius, d = 3, eta = {eta}"
+    )
     radius_ax.legend()
     count_ax.set(
         xscale="log",
@@ -96,7 +98,9 @@ def plan(problem: OccupancyProblem, gamma: float, seed: int, iterations: int) ->
 
 def draw_tree(ax, problem: OccupancyProblem, planner: BallRadiusRRTstar, path: np.ndarray, title: str) -> None:
     grid = problem.grid
-    ax.imshow(grid.occupied, origin="lower", extent=(grid.low[0], grid.high[0], grid.low[1], grid.high[1]), cmap="Greys")
+    ax.imshow(
+        grid.occupied, origin="lower", extent=(grid.low[0], grid.high[0], grid.low[1], grid.high[1]), cmap="Greys"
+    )
     data = planner.plannerData()
     points = np.array([data.getVertex(i).getState()[0:2] for i in range(data.numVertices())])
     segments = [(points[a], points[b]) for a in range(data.numVertices()) for b in data.getEdges(a)]
@@ -124,7 +128,10 @@ def main() -> None:
     print(f"rooms map: estimated gamma {estimated:.0f} m^2 (exact gamma* {exact:.0f} m^2)")
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 5.5))
-    for ax, gamma, title in ((axes[0], 100.0, "gamma = 100"), (axes[1], estimated, f"estimated gamma = {estimated:.0f}")):
+    for ax, gamma, title in (
+        (axes[0], 100.0, "gamma = 100"),
+        (axes[1], estimated, f"estimated gamma = {estimated:.0f}"),
+    ):
         draw_tree(ax, problem, *plan(problem, gamma, seed=1, iterations=args.iterations), title)
     fig.tight_layout()
     fig.savefig(args.output / "tree_gamma_100_vs_estimated.png", dpi=120)
@@ -136,7 +143,9 @@ def main() -> None:
         runs = [plan(problem, gamma, seed, args.iterations)[0].stats for seed in range(1, args.seeds + 1)]
         costs[gamma] = np.array([run.best_costs for run in runs])
         times[gamma] = statistics.median(run.time for run in runs)
-        print(f"gamma {gamma:8.0f}: median final cost {np.median(costs[gamma][:, -1]):.2f} m, median time {times[gamma]:.2f} s")
+        print(
+            f"gamma {gamma:8.0f}: median final cost {np.median(costs[gamma][:, -1]):.2f} m, median time {times[gamma]:.2f} s"
+        )
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     steps = np.arange(1, args.iterations + 1)
@@ -144,7 +153,11 @@ def main() -> None:
         low, mid, high = np.percentile(costs[gamma], [25, 50, 75], axis=0, method="nearest")  # inf until a path
         line = ax.plot(steps, mid, label=f"gamma = {gamma:.0f}")[0]
         ax.fill_between(steps, low, high, color=line.get_color(), alpha=0.2)
-    ax.set(xlabel="iterations", ylabel="best path cost (m)", title=f"Rooms map, {args.seeds} seeds: median and interquartile range")
+    ax.set(
+        xlabel="iterations",
+        ylabel="best path cost (m)",
+        title=f"Rooms map, {args.seeds} seeds: median and interquartile range",
+    )
     ax.legend()
     fig.tight_layout()
     fig.savefig(args.output / "cost_vs_iterations.png", dpi=120)
@@ -152,7 +165,11 @@ def main() -> None:
 
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.bar([f"{gamma:.0f}" for gamma in gammas], [times[gamma] for gamma in gammas])
-    ax.set(xlabel="gamma (m^2)", ylabel=f"median time for {args.iterations} iterations (s)", title="Planning time against gamma")
+    ax.set(
+        xlabel="gamma (m^2)",
+        ylabel=f"median time for {args.iterations} iterations (s)",
+        title="Planning time against gamma",
+    )
     fig.tight_layout()
     fig.savefig(args.output / "time_vs_gamma.png", dpi=120)
     plt.close(fig)

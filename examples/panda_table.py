@@ -10,8 +10,8 @@ import time
 import numpy as np
 from ompl import geometric as og
 
-from ompl_balance.core.counting import read_work
 from ompl_balance.collision.robots import load_example_robot_data_panda
+from ompl_balance.core.counting import read_work
 from ompl_balance.validity import CollisionChecker, Environment, setup_robot, space_for
 
 try:
@@ -47,5 +47,7 @@ for name, make_planner in planners:
     elapsed = time.perf_counter() - began
     work = read_work(si) - before
     length = ss.getSolutionPath().length() if solved else float("nan")
-    print(f"{name:20s} {str(solved.asString() if hasattr(solved, 'asString') else solved):16s} {elapsed:6.2f} s  "
-          f"path length {length:.2f} rad  states checked {work.states_checked}  motions checked {work.motions_checked}")
+    print(
+        f"{name:20s} {solved.asString() if hasattr(solved, 'asString') else solved!s:16s} {elapsed:6.2f} s  "
+        f"path length {length:.2f} rad  states checked {work.states_checked}  motions checked {work.motions_checked}"
+    )

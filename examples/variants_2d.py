@@ -9,17 +9,19 @@ Run: ``python examples/variants_2d.py``.
 from ompl import util as ou
 
 from ompl_balance.planners import PRESETS, BalancedRRTConnect
-from ompl_balance.worlds.boxes import get_problem
 from ompl_balance.samplers import GaussianValidStateSampler
+from ompl_balance.worlds.boxes import get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
 
 
 def report(planner, status) -> None:
     s = planner.stats
-    print(f"{planner.getName():26s} {str(status):15s} queries {s.states_checked:6d}  "
-          f"nodes {s.start_tree_size + s.goal_tree_size:5d}  swaps: alternate {s.swaps_alternate}, "
-          f"balance {s.swaps_balance}, steps {s.swaps_steps}, collision {s.swaps_collision}")
+    print(
+        f"{planner.getName():26s} {status!s:15s} queries {s.states_checked:6d}  "
+        f"nodes {s.start_tree_size + s.goal_tree_size:5d}  swaps: alternate {s.swaps_alternate}, "
+        f"balance {s.swaps_balance}, steps {s.swaps_steps}, collision {s.swaps_collision}"
+    )
 
 
 for planner_class in PRESETS.values():
@@ -32,7 +34,13 @@ for planner_class in PRESETS.values():
 ss = get_problem("bug_trap").setup()
 ss.getSpaceInformation().setValidStateSamplerAllocator(GaussianValidStateSampler)
 planner = BalancedRRTConnect(ss.getSpaceInformation(), "GaussianExhaustedRRTConnect")
-planner.params().setParams({"sample_policy": "valid_sampler", "swap_policy": "balance_nodes",
-                            "nearest_policy": "exhausted", "exhausted_after": "10"})
+planner.params().setParams(
+    {
+        "sample_policy": "valid_sampler",
+        "swap_policy": "balance_nodes",
+        "nearest_policy": "exhausted",
+        "exhausted_after": "10",
+    }
+)
 ss.setPlanner(planner)
 report(planner, ss.solve(10.0))

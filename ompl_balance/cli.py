@@ -75,10 +75,19 @@ def _dask_address(text: str) -> str:
 
 
 def _add_execution_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--jobs", type=_positive_int, default=1,
-                        help="runs at a time on this machine (default 1; more than the free cores distorts times)")
-    parser.add_argument("--dask", type=_dask_address, default=None, metavar="ADDRESS",
-                        help="run on a Dask cluster: tcp://HOST:PORT, or local:N for N local workers")
+    parser.add_argument(
+        "--jobs",
+        type=_positive_int,
+        default=1,
+        help="runs at a time on this machine (default 1; more than the free cores distorts times)",
+    )
+    parser.add_argument(
+        "--dask",
+        type=_dask_address,
+        default=None,
+        metavar="ADDRESS",
+        help="run on a Dask cluster: tcp://HOST:PORT, or local:N for N local workers",
+    )
     parser.add_argument("--no-progress", action="store_true", help="do not show a progress bar")
 
 
@@ -86,18 +95,35 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="ompl-balance", description=__doc__.split("\n\n")[0])
     commands = parser.add_subparsers(dest="command", required=True)
 
-    compare = commands.add_parser("compare", help="compare planners with stock RRTConnect on the built-in problems",
-                                  description=__doc__.split("\n\n", 1)[1])
+    compare = commands.add_parser(
+        "compare",
+        help="compare planners with stock RRTConnect on the built-in problems",
+        description=__doc__.split("\n\n", 1)[1],
+    )
     compare.add_argument("--runs", type=_positive_int, default=20, help="runs per planner and problem (default 20)")
-    compare.add_argument("--time-limit", type=_positive_float, default=5.0, help="seconds each run may plan (default 5)")
-    compare.add_argument("--problems", type=_problem_names, default=list(PROBLEMS),
-                         help=f"comma-separated problem names (default: all of {', '.join(PROBLEMS)})")
-    compare.add_argument("--planners", type=_planners, default=None,
-                         help="comma-separated planners: stock OMPL names (RRTConnect, RRT, PRM, ...), this package's "
-                              "planners and presets, each optionally NAME[param=value;...] (default: RRTConnect, "
-                              "BalancedRRTConnect, BalancedRRTConnect[balance_tree_sizes=0])")
-    compare.add_argument("--seed", type=_positive_int, default=None,
-                         help="experiment seed; every run's seed derives from it (default: drawn and printed)")
+    compare.add_argument(
+        "--time-limit", type=_positive_float, default=5.0, help="seconds each run may plan (default 5)"
+    )
+    compare.add_argument(
+        "--problems",
+        type=_problem_names,
+        default=list(PROBLEMS),
+        help=f"comma-separated problem names (default: all of {', '.join(PROBLEMS)})",
+    )
+    compare.add_argument(
+        "--planners",
+        type=_planners,
+        default=None,
+        help="comma-separated planners: stock OMPL names (RRTConnect, RRT, PRM, ...), this package's "
+        "planners and presets, each optionally NAME[param=value;...] (default: RRTConnect, "
+        "BalancedRRTConnect, BalancedRRTConnect[balance_tree_sizes=0])",
+    )
+    compare.add_argument(
+        "--seed",
+        type=_positive_int,
+        default=None,
+        help="experiment seed; every run's seed derives from it (default: drawn and printed)",
+    )
     compare.add_argument("-o", "--out", type=Path, default=None, help="keep results, logs and database in this folder")
     _add_execution_options(compare)
 
@@ -109,29 +135,47 @@ def build_parser() -> argparse.ArgumentParser:
     plot = commands.add_parser("plot", help="plots and summary tables of an output folder (matplotlib)")
     plot.add_argument("out", type=Path, help="output folder of bench or compare -o")
     plot.add_argument("--baseline", default=None, help="planner label the ratios refer to (default: the experiment's)")
-    plot.add_argument("--tree-iterations", type=_positive_int, default=300,
-                      help="iterations at which the 2-D tree pictures are drawn (default 300)")
+    plot.add_argument(
+        "--tree-iterations",
+        type=_positive_int,
+        default=300,
+        help="iterations at which the 2-D tree pictures are drawn (default 300)",
+    )
 
     gamma = commands.add_parser(
-        "gamma", help="estimate RRT*'s ball-radius constant for a problem",
+        "gamma",
+        help="estimate RRT*'s ball-radius constant for a problem",
         description="Estimate RRT*'s ball-radius constant gamma* = 2^d (1 + 1/d) mu(X_free) / zeta_d "
-                    "(Karaman & Frazzoli 2011) for a built-in problem or an occupancy grid you give, "
-                    "and the rewire_factor that makes OMPL's RRTstar use the same radius schedule.")
+        "(Karaman & Frazzoli 2011) for a built-in problem or an occupancy grid you give, "
+        "and the rewire_factor that makes OMPL's RRTstar use the same radius schedule.",
+    )
     source = gamma.add_mutually_exclusive_group()
-    source.add_argument("--problem", default="rooms",
-                        help="built-in problem: rooms, rooms_se2 (occupancy grid, counted exactly) or a box world of "
-                             "'ompl-balance compare' (open, narrow_gap, bug_trap, maze; Monte Carlo). Default: rooms")
-    source.add_argument("--grid", metavar="FILE.npy",
-                        help="a 2-D boolean occupancy array (True = occupied) saved with numpy.save")
-    gamma.add_argument("--resolution", type=_positive_float, default=0.2, help="cell side of --grid in metres (default 0.2)")
-    gamma.add_argument("--samples", type=_positive_int, default=20000,
-                       help="Monte Carlo samples when the measure is estimated (default 20000)")
+    source.add_argument(
+        "--problem",
+        default="rooms",
+        help="built-in problem: rooms, rooms_se2 (occupancy grid, counted exactly) or a box world of "
+        "'ompl-balance compare' (open, narrow_gap, bug_trap, maze; Monte Carlo). Default: rooms",
+    )
+    source.add_argument(
+        "--grid", metavar="FILE.npy", help="a 2-D boolean occupancy array (True = occupied) saved with numpy.save"
+    )
+    gamma.add_argument(
+        "--resolution", type=_positive_float, default=0.2, help="cell side of --grid in metres (default 0.2)"
+    )
+    gamma.add_argument(
+        "--samples",
+        type=_positive_int,
+        default=20000,
+        help="Monte Carlo samples when the measure is estimated (default 20000)",
+    )
     gamma.add_argument("--confidence", type=float, default=0.95, help="confidence level of the interval (default 0.95)")
-    gamma.add_argument("--monte-carlo", action="store_true",
-                       help="estimate by sampling even when a grid allows exact counting")
+    gamma.add_argument(
+        "--monte-carlo", action="store_true", help="estimate by sampling even when a grid allows exact counting"
+    )
     gamma.add_argument("--seed", type=int, default=None, help="seed of the Monte Carlo samples")
-    gamma.add_argument("--eta", type=float, default=0.0,
-                       help="maximum connection distance for the radius table (default 0.2 x extent)")
+    gamma.add_argument(
+        "--eta", type=float, default=0.0, help="maximum connection distance for the radius table (default 0.2 x extent)"
+    )
     return parser
 
 
@@ -158,7 +202,9 @@ def _gamma(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     elif args.problem in PROBLEMS:  # the box worlds have no grid: Monte Carlo only
         problem_name, grid, ss = args.problem, None, PROBLEMS[args.problem].setup()
     else:
-        parser.error(f"unknown problem {args.problem!r}; built-in problems: {', '.join([*OCCUPANCY_PROBLEMS, *PROBLEMS])}")
+        parser.error(
+            f"unknown problem {args.problem!r}; built-in problems: {', '.join([*OCCUPANCY_PROBLEMS, *PROBLEMS])}"
+        )
 
     si = ss.getSpaceInformation()
     try:
@@ -173,7 +219,9 @@ def _gamma(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     print(f"problem            {problem_name} ({si.getStateSpace().getName()}, d = {d})")
     print(f"space measure      {free.space_measure:.6g}")
     if free.exact:
-        print(f"free measure       {free.measure:.6g} (exact, {free.free_fraction:.2%} of the space, from the grid cells)")
+        print(
+            f"free measure       {free.measure:.6g} (exact, {free.free_fraction:.2%} of the space, from the grid cells)"
+        )
     else:
         print(
             f"free measure       {free.measure:.6g}, {free.confidence:.0%} interval [{free.low:.6g}, {free.high:.6g}] "
@@ -182,8 +230,10 @@ def _gamma(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     print(f"gamma*             {gamma:.6g}  (from the {'exact' if free.exact else 'upper'} free measure)")
     print(f"OMPL rewire_factor {ompl_rewire_factor(si, gamma):.6g}  (RRTstar, setKNearest(False), range = eta)")
     for n in (100, 1000, 10000):
-        print(f"radius at N={n:<6} {rewire_radius(n, d, gamma, eta):.4g}  "
-              f"(gamma = 100: {rewire_radius(n, d, 100.0, eta):.4g}; eta = {eta:.4g})")
+        print(
+            f"radius at N={n:<6} {rewire_radius(n, d, gamma, eta):.4g}  "
+            f"(gamma = 100: {rewire_radius(n, d, 100.0, eta):.4g}; eta = {eta:.4g})"
+        )
     return 0
 
 

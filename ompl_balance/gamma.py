@@ -152,7 +152,9 @@ def estimate_free_measure(
     if grid is not None:
         occupied = np.asarray(getattr(grid, "occupied", grid))
         if occupied.dtype != bool or occupied.size == 0:
-            raise ValueError("grid must be a non-empty boolean occupancy array (True = occupied) or have one as .occupied")
+            raise ValueError(
+                "grid must be a non-empty boolean occupancy array (True = occupied) or have one as .occupied"
+            )
         fraction = 1.0 - float(occupied.mean())
         measure = fraction * space_measure
         return FreeMeasure(measure, measure, measure, fraction, space_measure, 0, confidence, True)
@@ -168,7 +170,16 @@ def estimate_free_measure(
 
     interval = binomtest(free, int(samples)).proportion_ci(confidence_level=confidence, method="exact")
     low, high = interval.low, interval.high
-    return FreeMeasure(fraction * space_measure, low * space_measure, high * space_measure, fraction, space_measure, int(samples), confidence, False)
+    return FreeMeasure(
+        fraction * space_measure,
+        low * space_measure,
+        high * space_measure,
+        fraction,
+        space_measure,
+        int(samples),
+        confidence,
+        False,
+    )
 
 
 def estimate_ball_radius_constant(

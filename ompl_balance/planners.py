@@ -61,38 +61,62 @@ class RRTConnectSettings(Settings):
     """The parameters of :class:`BalancedRRTConnect` (OMPL names; distances in the space's units)."""
 
     range: float = param(
-        0.0, "longest motion added to a tree in one step; 0 picks 0.2 x the space's maximum extent at setup()",
-        low=0.0, suggestion="0.:1.:10000.")
+        0.0,
+        "longest motion added to a tree in one step; 0 picks 0.2 x the space's maximum extent at setup()",
+        low=0.0,
+        suggestion="0.:1.:10000.",
+    )
     intermediate_states: bool = param(
-        False, "add the states along each motion (at the validity-checking resolution) to the tree, "
-        "as OMPL's RRTConnect with addIntermediateStates")
+        False,
+        "add the states along each motion (at the validity-checking resolution) to the tree, "
+        "as OMPL's RRTConnect with addIntermediateStates",
+    )
     balance_tree_sizes: bool = param(
-        True, "grow the smaller tree once |a - b| / min(a, b) reaches max_tree_size_ratio (a, b the tree sizes); "
-        "otherwise swap_policy decides")
+        True,
+        "grow the smaller tree once |a - b| / min(a, b) reaches max_tree_size_ratio (a, b the tree sizes); "
+        "otherwise swap_policy decides",
+    )
     max_tree_size_ratio: float = param(
-        1.0, "the balancing rule's ratio; 1.0 grows the smaller tree once it is less than half the size of the other",
-        low=0.0, suggestion="0.:0.05:10.")
+        1.0,
+        "the balancing rule's ratio; 1.0 grows the smaller tree once it is less than half the size of the other",
+        low=0.0,
+        suggestion="0.:0.05:10.",
+    )
     swap_policy: str = param(
-        "alternate", "which tree grows when balancing does not decide: the other one each iteration (stock), "
+        "alternate",
+        "which tree grows when balancing does not decide: the other one each iteration (stock), "
         "the same one until swap_steps connect steps were taken, or until a connect collides",
-        choices=SWAP_POLICIES)
+        choices=SWAP_POLICIES,
+    )
     swap_steps: int = param(10, "connect steps after which balance_steps swaps trees", low=1, suggestion="1:1:100")
     nearest_policy: str = param(
-        "euclidean", "the node a tree grows from: the nearest, the nearest not exhausted (exhausted_after), "
-        "or the least distance x exhaustion scale (exhaustion_target)", choices=NEAREST_POLICIES)
+        "euclidean",
+        "the node a tree grows from: the nearest, the nearest not exhausted (exhausted_after), "
+        "or the least distance x exhaustion scale (exhaustion_target)",
+        choices=NEAREST_POLICIES,
+    )
     exhausted_after: int = param(15, "failed extensions after which a node is exhausted", low=1, suggestion="1:1:100")
-    exhaustion_target: int = param(5, "failures at which the exhaustion scale is lowest (0.9)", low=1, suggestion="1:1:100")
+    exhaustion_target: int = param(
+        5, "failures at which the exhaustion scale is lowest (0.9)", low=1, suggestion="1:1:100"
+    )
     sample_policy: str = param(
-        "uniform", "where each iteration's target comes from (see ompl_balance.policies.target_sampler)",
-        choices=SAMPLE_POLICIES)
-    goal_bias: float = param(0.05, "probability that goal_bias targets the other tree's root",
-                             low=0.0, high=1.0, suggestion="0.:.05:1.")
-    min_quality: float = param(0.0, "lowest acceptance probability of neighbour_quality",
-                               low=0.0, high=1.0, suggestion="0.:.05:1.")
+        "uniform",
+        "where each iteration's target comes from (see ompl_balance.policies.target_sampler)",
+        choices=SAMPLE_POLICIES,
+    )
+    goal_bias: float = param(
+        0.05, "probability that goal_bias targets the other tree's root", low=0.0, high=1.0, suggestion="0.:.05:1."
+    )
+    min_quality: float = param(
+        0.0, "lowest acceptance probability of neighbour_quality", low=0.0, high=1.0, suggestion="0.:.05:1."
+    )
     seed: int = param(
-        0, "0: each solve draws its seed from an OMPL RNG (repeated by ompl.util.RNG.setSeed); > 0: every solve "
+        0,
+        "0: each solve draws its seed from an OMPL RNG (repeated by ompl.util.RNG.setSeed); > 0: every solve "
         "uses this seed (real-vector spaces; other spaces sample with OMPL's sampler and seed)",
-        low=0, suggestion="0:1:1000000")
+        low=0,
+        suggestion="0:1:1000000",
+    )
 
 
 @dataclass
@@ -289,8 +313,12 @@ class BalancedRRTConnect(TreePlanner):
 
         def result(status: ob.PlannerStatus.PlannerStatusType, iterations: int = 0) -> tuple[Any, dict[str, Any]]:
             return status, dict(
-                iterations=iterations, start_tree_size=len(start_tree), goal_tree_size=len(goal_tree),
-                tree_swaps=sum(swaps), sampler_rejections=counts.rejections, sampler_checks=counts.checks,
+                iterations=iterations,
+                start_tree_size=len(start_tree),
+                goal_tree_size=len(goal_tree),
+                tree_swaps=sum(swaps),
+                sampler_rejections=counts.rejections,
+                sampler_checks=counts.checks,
                 **{f"swaps_{cause.name.lower()}": swaps[cause] for cause in SwapCause},
             )
 
@@ -311,15 +339,27 @@ class BalancedRRTConnect(TreePlanner):
         if not goal.couldSample():
             ou.OMPL_ERROR(f"{name}: Insufficient states in sampleable goal region")
             return result(ob.PlannerStatus.INVALID_GOAL)
-        ou.OMPL_INFORM(f"{name}: Starting planning with {len(start_tree) + len(goal_tree)} states already in datastructure")
+        ou.OMPL_INFORM(
+            f"{name}: Starting planning with {len(start_tree) + len(goal_tree)} states already in datastructure"
+        )
 
         # The policies of this solve.
-        choose_tree = tree_chooser(settings.swap_policy, settings.balance_tree_sizes, settings.max_tree_size_ratio,
-                                   settings.swap_steps)
-        find_nearest = nearest_finder(settings.nearest_policy, self._failures, settings.exhausted_after,
-                                      settings.exhaustion_target)
-        extender = Extender(points, settings.range, settings.intermediate_states, si.isValid, si.checkMotion,
-                            points.may_stall(settings.range), find_nearest, self._failures)
+        choose_tree = tree_chooser(
+            settings.swap_policy, settings.balance_tree_sizes, settings.max_tree_size_ratio, settings.swap_steps
+        )
+        find_nearest = nearest_finder(
+            settings.nearest_policy, self._failures, settings.exhausted_after, settings.exhaustion_target
+        )
+        extender = Extender(
+            points,
+            settings.range,
+            settings.intermediate_states,
+            si.isValid,
+            si.checkMotion,
+            points.may_stall(settings.range),
+            find_nearest,
+            self._failures,
+        )
         sample = target_sampler(settings.sample_policy, self._sample_context(points, rng, counts, find_nearest))
 
         status = ob.PlannerStatus.TIMEOUT
@@ -382,8 +422,16 @@ class BalancedRRTConnect(TreePlanner):
         self, points: Points, rng: np.random.Generator, counts: SamplerCounts, find_nearest: NearestFinder | None
     ) -> SampleContext:
         assert self._start_tree is not None and self._goal_tree is not None
-        context = SampleContext(points, self._start_tree, self._goal_tree, rng.random, counts, find_nearest,
-                                self.settings.goal_bias, self.settings.min_quality)
+        context = SampleContext(
+            points,
+            self._start_tree,
+            self._goal_tree,
+            rng.random,
+            counts,
+            find_nearest,
+            self.settings.goal_bias,
+            self.settings.min_quality,
+        )
         if self.settings.sample_policy == "valid_sampler":
             si = self.getSpaceInformation()
             context.valid_sampler = self._valid_state_sampler()
@@ -414,8 +462,9 @@ class BalancedRRTConnect(TreePlanner):
             start_node = start_tree.parent(start_node)
         else:
             goal_node = goal_tree.parent(goal_node)
-        return ([start_tree.state(node) for node in reversed(start_tree.branch(start_node))]
-                + [goal_tree.state(node) for node in goal_tree.branch(goal_node)])
+        return [start_tree.state(node) for node in reversed(start_tree.branch(start_node))] + [
+            goal_tree.state(node) for node in goal_tree.branch(goal_node)
+        ]
 
     def _fill_planner_data(self, data: ob.PlannerData, points: Points, keep_alive: list[ob.State]) -> None:
         """Start-tree vertices tag 1 (roots start vertices), goal-tree vertices tag 2 (roots

@@ -121,7 +121,9 @@ def tree_chooser(
     if not balance_tree_sizes:
         return lambda grew_start, start_size, goal_size, steps, collided: rule(grew_start, steps, collided)
 
-    def balanced(grew_start: bool, start_size: int, goal_size: int, steps: int, collided: bool) -> tuple[bool, SwapCause]:
+    def balanced(
+        grew_start: bool, start_size: int, goal_size: int, steps: int, collided: bool
+    ) -> tuple[bool, SwapCause]:
         smaller_is_start = balance_choice(start_size, goal_size, True, max_tree_size_ratio)
         if smaller_is_start is None:
             return rule(grew_start, steps, collided)

@@ -32,22 +32,38 @@ class RRTstarSettings(Settings):
     """The parameters of :class:`BallRadiusRRTstar`, named as in MATLAB's ``plannerRRTStar``."""
 
     max_connection_distance: float = param(
-        0.0, "eta: longest motion added in one step, and the cap of the rewiring radius (state-space distance); "
-        "0 picks 0.2 x the space's maximum extent at setup()", low=0.0, suggestion="0.:1.:10000.")
+        0.0,
+        "eta: longest motion added in one step, and the cap of the rewiring radius (state-space distance); "
+        "0 picks 0.2 x the space's maximum extent at setup()",
+        low=0.0,
+        suggestion="0.:1.:10000.",
+    )
     ball_radius_constant: float | str = param(
-        "auto", "gamma (distance^d); auto estimates gamma* for the problem's free space at setup() "
+        "auto",
+        "gamma (distance^d); auto estimates gamma* for the problem's free space at setup() "
         f"(ompl_balance.gamma.estimate_ball_radius_constant, {AUTO_GAMMA_SAMPLES} validity checks, not counted "
-        "in the solve's stats)", kind=float, low=0.0, low_open=True, words=("auto",), suggestion="1.:1.:1000000.")
-    goal_bias: float = param(0.05, "probability of sampling the goal region instead of the space",
-                             low=0.0, high=1.0, suggestion="0.:.05:1.")
+        "in the solve's stats)",
+        kind=float,
+        low=0.0,
+        low_open=True,
+        words=("auto",),
+        suggestion="1.:1.:1000000.",
+    )
+    goal_bias: float = param(
+        0.05, "probability of sampling the goal region instead of the space", low=0.0, high=1.0, suggestion="0.:.05:1."
+    )
     continue_after_goal_reached: bool = param(
-        True, "keep improving the path after the first one until the termination condition, an iteration or "
-        "node limit, or a satisfied cost threshold; false stops at the first path (MATLAB's default)")
+        True,
+        "keep improving the path after the first one until the termination condition, an iteration or "
+        "node limit, or a satisfied cost threshold; false stops at the first path (MATLAB's default)",
+    )
     max_iterations: int = param(10000, "iterations per solve(); 0: no limit", low=0, suggestion="0:1000:1000000")
-    max_nodes: int = param(10000, "stop once the tree has this many nodes; 0: no limit", low=0,
-                           suggestion="0:1000:1000000")
-    seed: int = param(0, "as BalancedRRTConnect's seed (numpy sampling in real-vector spaces)", low=0,
-                      suggestion="0:1:1000000")
+    max_nodes: int = param(
+        10000, "stop once the tree has this many nodes; 0: no limit", low=0, suggestion="0:1000:1000000"
+    )
+    seed: int = param(
+        0, "as BalancedRRTConnect's seed (numpy sampling in real-vector spaces)", low=0, suggestion="0:1:1000000"
+    )
 
 
 @dataclass
@@ -190,7 +206,9 @@ class BallRadiusRRTstar(TreePlanner):
         settings = self.settings
         if settings.max_connection_distance < 1e-12:
             settings.max_connection_distance = RANGE_AS_EXTENT_FRACTION * self.getSpaceInformation().getMaximumExtent()
-            ou.OMPL_INFORM(f"{self.getName()}: max_connection_distance computed to be {settings.max_connection_distance:g}")
+            ou.OMPL_INFORM(
+                f"{self.getName()}: max_connection_distance computed to be {settings.max_connection_distance:g}"
+            )
         if settings.ball_radius_constant == "auto":
             self._estimated_gamma = self._estimate_gamma()
 
@@ -234,9 +252,15 @@ class BallRadiusRRTstar(TreePlanner):
             for iteration, cost in improvements:
                 best_costs[iteration - 1 :] = cost
             first = improvements[0][0] if improvements and math.isinf(best_before) else None
-            return status, dict(iterations=iterations, tree_size=len(nodes), best_cost=nodes.best_cost(),
-                                first_solution_iteration=first, ball_radius_constant=gamma, rewires=rewires,
-                                best_costs=best_costs)
+            return status, {
+                "iterations": iterations,
+                "tree_size": len(nodes),
+                "best_cost": nodes.best_cost(),
+                "first_solution_iteration": first,
+                "ball_radius_constant": gamma,
+                "rewires": rewires,
+                "best_costs": best_costs,
+            }
 
         inputs = self.getPlannerInputStates()
         while (state := inputs.nextStart()) is not None:

@@ -53,9 +53,14 @@ class NearObstacleSettings(Settings):
     """The parameter of the Gaussian and bridge-test samplers."""
 
     standard_deviation: float = param(
-        math.nan, "standard deviation of the Gaussian neighbour (state-space distance); set at construction "
+        math.nan,
+        "standard deviation of the Gaussian neighbour (state-space distance); set at construction "
         "to a fraction of the space's maximum extent (0.1, OMPL's default; 0.05 for PassageSampler)",
-        low=0.0, low_open=True, suggestion="0.:0.01:10.", accessor="StdDev")
+        low=0.0,
+        low_open=True,
+        suggestion="0.:0.01:10.",
+        accessor="StdDev",
+    )
 
 
 @dataclass
@@ -63,10 +68,12 @@ class PassageSettings(NearObstacleSettings):
     """The parameters of :class:`PassageSampler`."""
 
     neighbours: int = param(8, "Gaussian neighbours drawn around each candidate (k)", low=1, suggestion="1:1:64")
-    min_colliding: int = param(1, "fewest neighbours in collision for the candidate to be a sample", low=0,
-                               suggestion="0:1:64")
-    max_colliding: int = param(7, "most neighbours in collision for the candidate to be a sample", low=0,
-                               suggestion="0:1:64")
+    min_colliding: int = param(
+        1, "fewest neighbours in collision for the candidate to be a sample", low=0, suggestion="0:1:64"
+    )
+    max_colliding: int = param(
+        7, "most neighbours in collision for the candidate to be a sample", low=0, suggestion="0:1:64"
+    )
 
     def check(self) -> None:
         if not 0 <= self.min_colliding <= self.max_colliding <= self.neighbours:
@@ -191,8 +198,13 @@ class PassageSampler(_NearObstacleSampler):
         stddev_fraction: float = 0.05,
     ) -> None:
         super().__init__(si, "passage", stddev_fraction)
-        self.settings.update({"neighbours": neighbours, "min_colliding": min_colliding,
-                              "max_colliding": neighbours - 1 if max_colliding is None else max_colliding})
+        self.settings.update(
+            {
+                "neighbours": neighbours,
+                "min_colliding": min_colliding,
+                "max_colliding": neighbours - 1 if max_colliding is None else max_colliding,
+            }
+        )
 
     def _sample(self, state: ob.State, near: ob.State | None, stddev: float) -> bool:
         neighbour, k = self._scratch, self.settings.neighbours

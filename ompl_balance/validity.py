@@ -40,7 +40,7 @@ class StateValidityChecker(ob.StateValidityChecker):
         self._dof = checker.robot.dof
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
-        return self.checker.is_valid(state[0:self._dof])
+        return self.checker.is_valid(state[0 : self._dof])
 
     def counters(self) -> dict[str, int]:
         return self.checker.counters()
@@ -70,7 +70,9 @@ class MotionValidator(ob.MotionValidator):
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         return self.check_motion_last_valid(s1, s2)[0]
 
-    def check_motion_last_valid(self, s1: ob.State, s2: ob.State, last_valid: ob.State | None = None) -> tuple[bool, float]:
+    def check_motion_last_valid(
+        self, s1: ob.State, s2: ob.State, last_valid: ob.State | None = None
+    ) -> tuple[bool, float]:
         """Validity of the edge and the fraction ``t`` of it known valid.
 
         As OMPL's ``checkMotion(s1, s2, lastValid)`` overload (which the Python
@@ -80,11 +82,11 @@ class MotionValidator(ob.MotionValidator):
         ``last_valid`` is not given (then the states are visited coarse to fine instead).
         """
         self.checker.counter.motions_checked += 1
-        b = np.array(s2[0:self._dof])
+        b = np.array(s2[0 : self._dof])
         if last_valid is None and not self.checker.is_valid(b):
             # s2 alone on the single-state path first: it decides most colliding edges
             return False, 1.0
-        a = np.array(s1[0:self._dof])
+        a = np.array(s1[0 : self._dof])
         nd = self._space.validSegmentCount(s1, s2)
         t = np.arange(1, nd + 1) / nd
         if last_valid is None:
@@ -136,7 +138,9 @@ def setup_robot(ss_or_si, checker: CollisionChecker) -> tuple[StateValidityCheck
     si = ss_or_si.getSpaceInformation() if isinstance(ss_or_si, og.SimpleSetup) else ss_or_si
     dimension = si.getStateDimension()
     if dimension != checker.robot.dof:
-        raise ValueError(f"space has dimension {dimension}, robot {checker.robot.name!r} has {checker.robot.dof} joints")
+        raise ValueError(
+            f"space has dimension {dimension}, robot {checker.robot.name!r} has {checker.robot.dof} joints"
+        )
     validity = StateValidityChecker(si, checker)
     motion = MotionValidator(si, checker)
     si.setStateValidityChecker(validity)

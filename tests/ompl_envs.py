@@ -91,7 +91,9 @@ def load_environment(path: Path) -> Environment2D:
     except (StopIteration, ValueError) as error:
         raise ValueError(f"{path}: malformed environment file ({error or 'ended early'})") from error
     if width * height == 0 or len(cells) != width * height:
-        raise ValueError(f"{path}: the environment has a 0 dimension or no 'environment:' block of {width} x {height} cells")
+        raise ValueError(
+            f"{path}: the environment has a 0 dimension or no 'environment:' block of {width} x {height} cells"
+        )
     grid = tuple(tuple(cells[x * height : (x + 1) * height]) for x in range(width))
     return Environment2D(width, height, start, goal, grid)
 
@@ -142,7 +144,7 @@ class Circles2D:
         self._cell_x = (self.max_x - self.min_x) / self.BUCKETS
         self._cell_y = (self.max_y - self.min_y) / self.BUCKETS
         # per cell (row-major, x fastest): (x, y, r^2) of the circles whose square meets it
-        self._buckets: list[list[tuple[float, float, float]]] = [[] for _ in range(self.BUCKETS ** 2)]
+        self._buckets: list[list[tuple[float, float, float]]] = [[] for _ in range(self.BUCKETS**2)]
         for x, y, r in circles:
             for i in range(self._column(x - r), self._column(x + r) + 1):
                 for j in range(self._row(y - r), self._row(y + r) + 1):
@@ -165,7 +167,9 @@ class Circles2D:
         column = int((x - self.min_x) / self._cell_x)  # (_column and _row, inlined: the hot path)
         row = int((y - self.min_y) / self._cell_y)
         last = self.BUCKETS - 1
-        for cx, cy, r2 in self._buckets[(row if row < last else last) * self.BUCKETS + (column if column < last else last)]:
+        for cx, cy, r2 in self._buckets[
+            (row if row < last else last) * self.BUCKETS + (column if column < last else last)
+        ]:
             dx = cx - x
             dy = cy - y
             if dx * dx + dy * dy < r2:

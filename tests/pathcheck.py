@@ -8,19 +8,22 @@ discrete motion validator looks at: for each segment ``(a, b)``, the states
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 
 from ompl import base as ob
 from ompl import geometric as og
 
 
-def invalid_points(si: ob.SpaceInformation, path: og.PathGeometric, is_valid: Callable[[ob.State], bool]) -> list[tuple[int, int]]:
+def invalid_points(
+    si: ob.SpaceInformation, path: og.PathGeometric, is_valid: Callable[[ob.State], bool]
+) -> list[tuple[int, int]]:
     """(segment, step) of every state along ``path`` that ``is_valid`` rejects."""
     space = si.getStateSpace()
     scratch = si.allocState()
     bad = []
     states = [path.getState(i) for i in range(path.getStateCount())]
-    for segment, (a, b) in enumerate(zip(states, states[1:])):
+    for segment, (a, b) in enumerate(itertools.pairwise(states)):
         steps = space.validSegmentCount(a, b)
         for step in range(steps + 1):
             space.interpolate(a, b, step / steps, scratch)
@@ -31,7 +34,9 @@ def invalid_points(si: ob.SpaceInformation, path: og.PathGeometric, is_valid: Ca
     return bad
 
 
-def assert_valid_solution(ss: og.SimpleSetup, is_valid: Callable[[ob.State], bool], starts, goal_test) -> og.PathGeometric:
+def assert_valid_solution(
+    ss: og.SimpleSetup, is_valid: Callable[[ob.State], bool], starts, goal_test
+) -> og.PathGeometric:
     """The solution path of ``ss`` is exact, valid under ``is_valid``, and joins a start to the goal.
 
     ``starts`` are OMPL states, one of which the path must begin at; ``goal_test(state)``

@@ -10,12 +10,18 @@ from pathlib import Path
 import pytest
 
 from ompl_balance.bench.compare import bench, compare_experiment, parse_planners
-from ompl_balance.cli import main
-from ompl_balance.bench.experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec, load_experiment, run_seed
+from ompl_balance.bench.experiment import (
+    Experiment,
+    ExperimentError,
+    PlannerSpec,
+    ProblemSpec,
+    load_experiment,
+    run_seed,
+)
 from ompl_balance.bench.logs import write_logs
 from ompl_balance.bench.runner import run_isolated
 from ompl_balance.bench.summary import summarize
-
+from ompl_balance.cli import main
 
 GOOD = """\
 name = "tiny"
@@ -45,8 +51,17 @@ def write(tmp_path: Path, text: str) -> Path:
 
 def deterministic(record: dict) -> tuple:
     """What a seeded run must repeat exactly (everything but times and memory)."""
-    properties = {k: v for k, v in record["properties"].items() if not k.startswith(("time", "simplification time", "memory"))}
-    return record["problem"], record["planner"], record["run"], record["seed"], record["status"], sorted(properties.items())
+    properties = {
+        k: v for k, v in record["properties"].items() if not k.startswith(("time", "simplification time", "memory"))
+    }
+    return (
+        record["problem"],
+        record["planner"],
+        record["run"],
+        record["seed"],
+        record["status"],
+        sorted(properties.items()),
+    )
 
 
 # -- experiment files ---------------------------------------------------------------------
@@ -66,13 +81,25 @@ def test_experiment_file_reads_planners_params_and_seeds(tmp_path):
 @pytest.mark.parametrize(
     ("change", "expected"),
     [
-        (('name = "RRTConnect"', 'name = "RRTConnectt"'), ["planners[0].name", "line 10", "unknown planner 'RRTConnectt'", "BalancedRRTConnect"]),
-        (("max_tree_size_ratio = 0.5", "max_tree_ratio = 0.5"), ["planners[1].params.max_tree_ratio", "line 16", "max_tree_size_ratio"]),
-        (("max_tree_size_ratio = 0.5", "max_tree_size_ratio = -1"), ["planners[1].params.max_tree_size_ratio", "line 16"]),
+        (
+            ('name = "RRTConnect"', 'name = "RRTConnectt"'),
+            ["planners[0].name", "line 10", "unknown planner 'RRTConnectt'", "BalancedRRTConnect"],
+        ),
+        (
+            ("max_tree_size_ratio = 0.5", "max_tree_ratio = 0.5"),
+            ["planners[1].params.max_tree_ratio", "line 16", "max_tree_size_ratio"],
+        ),
+        (
+            ("max_tree_size_ratio = 0.5", "max_tree_size_ratio = -1"),
+            ["planners[1].params.max_tree_size_ratio", "line 16"],
+        ),
         (("range = 0.3", "rang = 0.3"), ["planners[0].params.rang", "line 11", "range"]),
         (("runs = 2", "runs = -3"), ["runs", "line 2", "whole number >= 1"]),
         (("time_limit = 1.0", "time_limit = 0"), ["time_limit", "line 3", "positive"]),
-        (('builtin = "open"', 'mbm = "nowhere.json"\nrobot = "."'), ["problems[0].mbm", "line 7", "nor a file", "nowhere.json"]),
+        (
+            ('builtin = "open"', 'mbm = "nowhere.json"\nrobot = "."'),
+            ["problems[0].mbm", "line 7", "nor a file", "nowhere.json"],
+        ),
         (('builtin = "open"', 'builtin = "opne"'), ["problems[0].builtin", "line 7", "narrow_gap"]),
         (("seed = 7", "sede = 7"), ["sede", "line 4", "unknown key"]),
         (("runs = 2", "runs = 2 ]"), ["not valid TOML", "line 2"]),
@@ -93,7 +120,12 @@ def test_bad_experiment_files_fail_before_any_run_naming_key_and_line(tmp_path, 
 def test_mbm_problems_expand_ids_and_ranges(tmp_path):
     text = GOOD.replace('builtin = "open"', 'mbm = "table_pick"\nids = [3, "10-12"]')
     experiment = load_experiment(write(tmp_path, text))
-    assert [p.name for p in experiment.problems] == ["table_pick.003", "table_pick.010", "table_pick.011", "table_pick.012"]
+    assert [p.name for p in experiment.problems] == [
+        "table_pick.003",
+        "table_pick.010",
+        "table_pick.011",
+        "table_pick.012",
+    ]
     with pytest.raises(ExperimentError, match=r"problems\[0\].ids: ids \[101\] not in the file"):
         load_experiment(write(tmp_path, text.replace('"10-12"', '"10-101"')))
 
@@ -116,16 +148,21 @@ def tiny_sweep(tmp_path_factory):
     experiment = Experiment(
         name="tiny",
         problems=(ProblemSpec("open", "builtin", "open"), ProblemSpec("narrow_gap", "builtin", "narrow_gap")),
-        planners=(PlannerSpec("RRTConnect", "RRTConnect", params={"range": "0.3"}),
-                  PlannerSpec("Balanced r=0.5", "BalancedRRTConnect", params={"max_tree_size_ratio": "0.5"}),
-                  PlannerSpec("RRT", "RRT")),
-        runs=2, time_limit=10.0, seed=7)  # a limit no run should reach: limited runs do not repeat
+        planners=(
+            PlannerSpec("RRTConnect", "RRTConnect", params={"range": "0.3"}),
+            PlannerSpec("Balanced r=0.5", "BalancedRRTConnect", params={"max_tree_size_ratio": "0.5"}),
+            PlannerSpec("RRT", "RRT"),
+        ),
+        runs=2,
+        time_limit=10.0,
+        seed=7,
+    )  # a limit no run should reach: limited runs do not repeat
     records = bench(experiment, out, jobs=2, progress=False)
     return experiment, out, records
 
 
 def test_sweep_records_every_run_once_with_counters(tiny_sweep):
-    experiment, out, records = tiny_sweep
+    experiment, _out, records = tiny_sweep
     assert sorted((r["problem"], r["planner"], r["run"]) for r in records) == sorted(t.key for t in experiment.tasks())
     assert all(r["status"] == "EXACT_SOLUTION" and r["properties"]["solved BOOLEAN"] == 1 for r in records)
     for record in records:
@@ -146,7 +183,7 @@ def test_a_run_re_executed_alone_repeats_its_result(tiny_sweep):
 
 
 def test_rerun_skips_finished_runs_and_more_runs_add_only_the_missing(tiny_sweep, tmp_path):
-    experiment, out, records = tiny_sweep
+    experiment, out, _records = tiny_sweep
     lines = (out / "results.jsonl").read_text().splitlines()
     bench(experiment, out, progress=False)
     assert (out / "results.jsonl").read_text().splitlines() == lines  # nothing run again
@@ -155,7 +192,7 @@ def test_rerun_skips_finished_runs_and_more_runs_add_only_the_missing(tiny_sweep
 
 
 def test_ompl_statistics_script_reads_the_logs(tiny_sweep, tmp_path):
-    experiment, out, records = tiny_sweep
+    _experiment, out, records = tiny_sweep
     logs = sorted((out / "logs").glob("*.log"))
     assert [log.name for log in logs] == ["tiny.narrow_gap.log", "tiny.open.log"]
     database = tmp_path / "ompl.db"
@@ -165,15 +202,32 @@ def test_ompl_statistics_script_reads_the_logs(tiny_sweep, tmp_path):
     with sqlite3.connect(database) as db:
         assert db.execute("SELECT COUNT(*) FROM experiments").fetchone()[0] == 2
         assert db.execute("SELECT COUNT(*) FROM runs").fetchone()[0] == len(records) == 12
-        per_planner = dict(db.execute("SELECT name, COUNT(*) FROM runs JOIN plannerConfigs ON plannerid = plannerConfigs.id GROUP BY name"))
+        per_planner = dict(
+            db.execute(
+                "SELECT name, COUNT(*) FROM runs JOIN plannerConfigs ON plannerid = plannerConfigs.id GROUP BY name"
+            )
+        )
         assert per_planner == {"RRTConnect": 4, "Balanced r=0.5": 4, "RRT": 4}
         settings = dict(db.execute("SELECT name, settings FROM plannerConfigs"))
         assert "max_tree_size_ratio = 0.5" in settings["Balanced r=0.5"] and "seed = run" in settings["Balanced r=0.5"]
         assert "range = 0.3" in settings["RRTConnect"]
         columns = {row[1] for row in db.execute("PRAGMA table_info(runs)")}
-        assert {"time", "solved", "status", "solution_length", "solution_segments", "simplified_solution_length",
-                "graph_states", "iterations", "start_tree_size", "goal_tree_size", "tree_swaps", "validity_checks",
-                "motion_checks", "seed"} <= columns
+        assert {
+            "time",
+            "solved",
+            "status",
+            "solution_length",
+            "solution_segments",
+            "simplified_solution_length",
+            "graph_states",
+            "iterations",
+            "start_tree_size",
+            "goal_tree_size",
+            "tree_swaps",
+            "validity_checks",
+            "motion_checks",
+            "seed",
+        } <= columns
         checks = db.execute("SELECT SUM(validity_checks) FROM runs").fetchone()[0]
         assert checks == sum(r["properties"]["validity checks INTEGER"] for r in records)
     assert (out / "benchmark.db").is_file()
@@ -182,7 +236,11 @@ def test_ompl_statistics_script_reads_the_logs(tiny_sweep, tmp_path):
 def test_summary_ratios_are_to_the_baseline(tiny_sweep):
     experiment, out, records = tiny_sweep
     summaries = summarize(records, "RRTConnect", [p.label for p in experiment.planners])
-    assert [(s.problem, s.planner) for s in summaries][:3] == [("open", "RRTConnect"), ("open", "Balanced r=0.5"), ("open", "RRT")]
+    assert [(s.problem, s.planner) for s in summaries][:3] == [
+        ("open", "RRTConnect"),
+        ("open", "Balanced r=0.5"),
+        ("open", "RRT"),
+    ]
     for s in summaries:
         assert s.time.interval[0] <= s.time.median <= s.time.interval[1]
         assert s.checks.interval[0] <= s.checks.median <= s.checks.interval[1]
@@ -214,8 +272,13 @@ def test_plot_writes_boxplots_curves_and_trees(tiny_sweep):
 
 def test_write_logs_leaves_blank_what_a_crashed_run_lacks(tiny_sweep, tmp_path):
     experiment, _, records = tiny_sweep
-    crashed = {**records[0], "run": 9, "status": "CRASH", "error": "killed by SIGSEGV",
-               "properties": {"time REAL": 0.5, "status ENUM": 7, "solved BOOLEAN": 0}}
+    crashed = {
+        **records[0],
+        "run": 9,
+        "status": "CRASH",
+        "error": "killed by SIGSEGV",
+        "properties": {"time REAL": 0.5, "status ENUM": 7, "solved BOOLEAN": 0},
+    }
     log = write_logs(experiment, [records[0], crashed], tmp_path)[0].read_text()
     run_lines = [line for line in log.splitlines() if line.endswith("; ")]
     assert len(run_lines) == 2 and run_lines[0].count(";") == run_lines[1].count(";")
@@ -226,9 +289,17 @@ def test_pooling_by_scenario_makes_one_cell_per_scenario_and_planner():
     from ompl_balance.bench.summary import pooled_by_scenario, summarize
 
     def record(problem, planner, time_s):
-        return {"problem": problem, "planner": planner, "error": "",
-                "properties": {"time REAL": time_s, "solved BOOLEAN": 1, "validity checks INTEGER": 10,
-                               "graph states INTEGER": 5}}
+        return {
+            "problem": problem,
+            "planner": planner,
+            "error": "",
+            "properties": {
+                "time REAL": time_s,
+                "solved BOOLEAN": 1,
+                "validity checks INTEGER": 10,
+                "graph states INTEGER": 5,
+            },
+        }
 
     records = [record(f"box.{i:03d}", planner, t) for i in (1, 2) for planner, t in (("A", 1.0), ("B", 0.5))]
     cells = summarize(pooled_by_scenario(records), baseline="A", order=["A", "B"])

@@ -13,10 +13,10 @@ from pathlib import Path
 
 import pytest
 from ompl import base as ob
+from test_benchmark import deterministic
 
 from ompl_balance.bench.compare import bench
 from ompl_balance.bench.experiment import Experiment, PlannerSpec, ProblemSpec
-from test_benchmark import deterministic
 
 REPO = Path(__file__).resolve().parents[1]
 TESTS = Path(__file__).resolve().parent
@@ -49,16 +49,28 @@ def test_crash_and_hang_are_recorded_and_the_sweep_goes_on(tmp_path):
     experiment = Experiment(
         name="failing",
         problems=(ProblemSpec("open", "builtin", "open"),),
-        planners=(PlannerSpec("RRTConnect", "RRTConnect"),
-                  PlannerSpec("segfault", factory="test_benchmark_runs:segfaulting_planner"),
-                  PlannerSpec("hang", factory="test_benchmark_runs:hanging_planner")),
-        runs=2, time_limit=0.5, seed=3, hard_limit_margin=1.0)
+        planners=(
+            PlannerSpec("RRTConnect", "RRTConnect"),
+            PlannerSpec("segfault", factory="test_benchmark_runs:segfaulting_planner"),
+            PlannerSpec("hang", factory="test_benchmark_runs:hanging_planner"),
+        ),
+        runs=2,
+        time_limit=0.5,
+        seed=3,
+        hard_limit_margin=1.0,
+    )
     began = time.perf_counter()
     records = bench(experiment, tmp_path, jobs=2, progress=False)
     assert time.perf_counter() - began < 30  # the hung runs were killed at 2 x 0.5 + 1 s
     status = {(r["planner"], r["run"]): r["status"] for r in records}
-    assert status == {("RRTConnect", 0): "EXACT_SOLUTION", ("RRTConnect", 1): "EXACT_SOLUTION",
-                      ("segfault", 0): "CRASH", ("segfault", 1): "CRASH", ("hang", 0): "TIMEOUT", ("hang", 1): "TIMEOUT"}
+    assert status == {
+        ("RRTConnect", 0): "EXACT_SOLUTION",
+        ("RRTConnect", 1): "EXACT_SOLUTION",
+        ("segfault", 0): "CRASH",
+        ("segfault", 1): "CRASH",
+        ("hang", 0): "TIMEOUT",
+        ("hang", 1): "TIMEOUT",
+    }
     errors = {r["planner"]: r["error"] for r in records}
     assert "SIGSEGV" in errors["segfault"] and "hard limit" in errors["hang"]
     assert all(r["properties"]["solved BOOLEAN"] == 0 for r in records if r["planner"] != "RRTConnect")
@@ -95,8 +107,13 @@ def test_a_killed_sweep_resumes_without_repeating_or_losing_runs(tmp_path):
     experiment, out = tmp_path / "resume.toml", tmp_path / "out"
     experiment.write_text(RESUME_TOML)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), str(TESTS), os.environ.get("PYTHONPATH", "")])}
-    sweep = subprocess.Popen(_bench_command(experiment, out), env=env, start_new_session=True,
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    sweep = subprocess.Popen(
+        _bench_command(experiment, out),
+        env=env,
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     results = out / "results.jsonl"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and (not results.exists() or len(results.read_text().splitlines()) < 5):
@@ -106,13 +123,15 @@ def test_a_killed_sweep_resumes_without_repeating_or_losing_runs(tmp_path):
     before = results.read_text().splitlines()
     assert 5 <= len(before) < 32, "the sweep should have been killed mid-way"
 
-    finished = subprocess.run(_bench_command(experiment, out), env=env, capture_output=True, text=True, timeout=300)
+    finished = subprocess.run(
+        _bench_command(experiment, out), env=env, capture_output=True, text=True, timeout=300, check=False
+    )
     assert finished.returncode == 0, finished.stderr
     after = [json.loads(line) for line in results.read_text().splitlines() if line.strip()]
     keys = [(r["problem"], r["planner"], r["run"]) for r in after]
     assert len(keys) == len(set(keys)) == 2 * 2 * 8  # nothing twice, nothing missing
     kept = [json.loads(line) for line in before if line.endswith("}")]
-    assert after[:len(kept)] == kept  # what finished before the kill is kept as it was
+    assert after[: len(kept)] == kept  # what finished before the kill is kept as it was
     assert "32 runs in" in finished.stdout
 
 
@@ -122,11 +141,17 @@ def test_dask_cluster_gives_the_results_of_the_local_pool(tmp_path, monkeypatch)
     experiment = Experiment(
         name="same",
         problems=(ProblemSpec("open", "builtin", "open"), ProblemSpec("narrow_gap", "builtin", "narrow_gap")),
-        planners=(PlannerSpec("RRTConnect", "RRTConnect"), PlannerSpec("BalancedRRTConnect", "BalancedRRTConnect"),
-                  PlannerSpec("alternating", "BalancedRRTConnect", params={"balance_tree_sizes": "0"}),
-                  # draws from OMPL's RNG (valid-state sampler): repeated by the run's process seed
-                  PlannerSpec("GaussianPassageRRTConnect", "GaussianPassageRRTConnect")),
-        runs=3, time_limit=10.0, seed=5)
+        planners=(
+            PlannerSpec("RRTConnect", "RRTConnect"),
+            PlannerSpec("BalancedRRTConnect", "BalancedRRTConnect"),
+            PlannerSpec("alternating", "BalancedRRTConnect", params={"balance_tree_sizes": "0"}),
+            # draws from OMPL's RNG (valid-state sampler): repeated by the run's process seed
+            PlannerSpec("GaussianPassageRRTConnect", "GaussianPassageRRTConnect"),
+        ),
+        runs=3,
+        time_limit=10.0,
+        seed=5,
+    )
     local = bench(experiment, tmp_path / "local", jobs=2, progress=False)
     distributed = bench(experiment, tmp_path / "dask", dask="local:2", progress=False)
     assert len(local) == len(distributed) == 24

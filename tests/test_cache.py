@@ -1,16 +1,17 @@
 """The disk cache returns what was computed, and never stands in the way."""
 
 import numpy as np
+from test_validity import arm3_scene
 
 from ompl_balance.collision.cache import cache_dir, cached_arrays
 from ompl_balance.collision.checker import CollisionChecker
-from test_validity import arm3_scene
 
 
 def counting(calls: list):
     def compute():
         calls.append(1)
         return {"a": np.arange(5.0) / 3.0, "b": np.array([[True, False]])}
+
     return compute
 
 
@@ -68,8 +69,7 @@ def test_checker_volumes_from_the_cache_equal_computed_ones_arm3(tmp_path, monke
 def test_checker_volumes_from_the_cache_equal_computed_ones_panda(tmp_path, monkeypatch):
     from ompl_balance.collision.robots import load_panda_vamp
 
-    computed, read = volumes_without_and_with_cache(lambda: load_panda_vamp(),
-                                                     tmp_path, monkeypatch)
+    computed, read = volumes_without_and_with_cache(load_panda_vamp, tmp_path, monkeypatch)
     assert (computed.pair_table >= 0).any()  # the tables are among what was cached
     for name, value in computed._asdict().items():
         np.testing.assert_array_equal(value, getattr(read, name), err_msg=name)

@@ -13,12 +13,23 @@ def test_compare_prints_a_table_per_problem(capsys):
     assert len(rows) == 6  # 3 planners x 2 problems
     stock_rows = [row for row in rows if row.startswith("| RRTConnect |")]
     assert len(stock_rows) == 2
-    assert all(row.count("| 1.00 [1.00, 1.00] |") == 3 for row in stock_rows)  # time, checks, nodes: stock is the baseline
+    assert all(
+        row.count("| 1.00 [1.00, 1.00] |") == 3 for row in stock_rows
+    )  # time, checks, nodes: stock is the baseline
     assert all("| 2 | 100% |" in row for row in rows)
 
 
 def test_compare_takes_stock_planners_and_presets_by_name(capsys):
-    args = ["compare", "--runs", "1", "--problems", "open", "--planners", "RRT,BalancedRRTConnect[range=0.1]", "--no-progress"]
+    args = [
+        "compare",
+        "--runs",
+        "1",
+        "--problems",
+        "open",
+        "--planners",
+        "RRT,BalancedRRTConnect[range=0.1]",
+        "--no-progress",
+    ]
     assert main(args) == 0
     rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| ") and "planner" not in line]
     assert [row.split(" | ")[0] for row in rows] == ["| RRT", "| BalancedRRTConnect[range=0.1]"]

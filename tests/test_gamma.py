@@ -11,6 +11,7 @@ from ompl import geometric as og
 from ompl import util as ou
 from scipy.stats import binom
 
+from ompl_balance.cli import main
 from ompl_balance.gamma import (
     ball_radius_constant,
     estimate_ball_radius_constant,
@@ -19,7 +20,6 @@ from ompl_balance.gamma import (
     rewire_radius,
     unit_ball_volume,
 )
-from ompl_balance.cli import main
 from ompl_balance.worlds.occupancy import GridValidityChecker, OccupancyGrid, OccupancyProblem, rooms_problem
 
 ou.setLogLevel(ou.LOG_WARN)
@@ -81,7 +81,10 @@ def test_rewire_radius_decays_as_documented():
     assert rewire_radius(1000, 2, 100.0, 0.7) == pytest.approx(float(rewire_radius(np.array([1000]), 2, 100.0, 0.7)[0]))
 
 
-@pytest.mark.parametrize(("args", "what"), [((0, 2, 1.0), "n"), ((10, 2, 0.0), "gamma"), ((10, 2, 1.0, 0.0), "eta"), ((10, 0, 1.0), "dimension")])
+@pytest.mark.parametrize(
+    ("args", "what"),
+    [((0, 2, 1.0), "n"), ((10, 2, 0.0), "gamma"), ((10, 2, 1.0, 0.0), "eta"), ((10, 0, 1.0), "dimension")],
+)
 def test_rewire_radius_rejects_bad_arguments(args, what):
     with pytest.raises(ValueError, match=what):
         rewire_radius(*args)
@@ -126,7 +129,9 @@ def test_interval_coverage_is_at_least_the_confidence_level():
         intervals = [_reported_interval(free, samples) for free in range(samples + 1)]
         for fraction in (0.05, 0.5, 0.7025, 0.99):
             coverage = sum(
-                binom.pmf(free, samples, fraction) for free, (low, high) in enumerate(intervals) if low <= fraction <= high
+                binom.pmf(free, samples, fraction)
+                for free, (low, high) in enumerate(intervals)
+                if low <= fraction <= high
             )
             assert coverage >= 0.95, (fraction, samples, coverage)
 
@@ -152,7 +157,7 @@ def _reported_interval(free: int, samples: int) -> tuple[float, float]:
 
 
 def test_monte_carlo_interval_narrows_with_samples():
-    si, grid, _ss = _checkerboard_setup()
+    si, _grid, _ss = _checkerboard_setup()
     small = estimate_free_measure(si, samples=200, rng=1)
     large = estimate_free_measure(si, samples=4000, rng=1)
     assert large.high - large.low < (small.high - small.low) / 3

@@ -8,9 +8,9 @@ import pytest
 import yourdfpy
 
 from ompl_balance.collision.kinematics import RobotModel
+from ompl_balance.collision.robots import PANDA_VAMP_DIR as PANDA_VAMP
 
 ROBOTS = Path(__file__).resolve().parent / "robots"
-from ompl_balance.collision.robots import PANDA_VAMP_DIR as PANDA_VAMP
 
 
 def load_arm3():
@@ -38,8 +38,15 @@ def test_arm3_model():
     assert robot.body_count == 5  # root, three active joints, the mimic joint; fixed flange and tool folded in
     names = [(robot.geometries[a].link, robot.geometries[b].link) for a, b in robot.self_collision_pairs]
     # base-boom disabled by the SRDF; adjacent bodies and the rigid slider/flange/tool group skipped
-    assert set(names) == {("base", "slider"), ("base", "tool"), ("base", "finger"), ("column", "slider"),
-                          ("column", "tool"), ("column", "finger"), ("boom", "finger")}
+    assert set(names) == {
+        ("base", "slider"),
+        ("base", "tool"),
+        ("base", "finger"),
+        ("column", "slider"),
+        ("column", "tool"),
+        ("column", "finger"),
+        ("boom", "finger"),
+    }
 
 
 def test_fk_matches_yourdfpy_arm3():
@@ -86,16 +93,16 @@ def test_unreadable_mesh_names_file_and_link(tmp_path):
     shutil.copy(ROBOTS / "arm3.urdf", tmp_path / "arm3.urdf")
     (tmp_path / "meshes").mkdir()
     (tmp_path / "meshes" / "cone.obj").write_text("this is not a mesh\n")
-    with pytest.raises((ValueError, FileNotFoundError), match="link '(boom|slider)'"):
+    with pytest.raises((ValueError, FileNotFoundError), match=r"link '(boom|slider)'"):
         RobotModel.from_urdf(tmp_path / "arm3.urdf", package_map={"testbot": str(tmp_path)})
 
 
 def test_urdf_that_does_not_parse(tmp_path):
     bad = tmp_path / "bad.urdf"
     bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'><parent link='a'/>")
-    with pytest.raises(ValueError, match="bad.urdf"):
+    with pytest.raises(ValueError, match=r"bad\.urdf"):
         RobotModel.from_urdf(bad)
-    with pytest.raises(FileNotFoundError, match="nowhere.urdf"):
+    with pytest.raises(FileNotFoundError, match=r"nowhere\.urdf"):
         RobotModel.from_urdf(tmp_path / "nowhere.urdf")
 
 

@@ -1,21 +1,36 @@
 """MotionBenchMaker problems: loading, bad files, and validity of starts and goals with VAMP's Panda."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from ompl_balance.worlds.mbm import load_mbm
 from ompl_balance.collision.checker import CollisionChecker
+from ompl_balance.worlds.mbm import load_mbm
 
 SCENARIOS = ["table_pick", "table_under_pick", "box", "bookshelf_small"]
 
 PROBLEM = {
-    "id": 7, "start": [0.0, 0.1, 0.2], "goals": [[0.3, 0.4, 0.5]], "valid": True,
+    "id": 7,
+    "start": [0.0, 0.1, 0.2],
+    "goals": [[0.3, 0.4, 0.5]],
+    "valid": True,
     "obstacles": [
-        {"type": "box", "name": "table", "position": [1, 0, 0], "orientation_xyzw": [0, 0, 0, 1], "half_extents": [0.5, 0.5, 0.1]},
-        {"type": "cylinder", "name": "can", "position": [0, 1, 0], "orientation_xyzw": [0, 0, 0, 1], "radius": 0.1, "length": 0.3},
+        {
+            "type": "box",
+            "name": "table",
+            "position": [1, 0, 0],
+            "orientation_xyzw": [0, 0, 0, 1],
+            "half_extents": [0.5, 0.5, 0.1],
+        },
+        {
+            "type": "cylinder",
+            "name": "can",
+            "position": [0, 1, 0],
+            "orientation_xyzw": [0, 0, 0, 1],
+            "radius": 0.1,
+            "length": 0.3,
+        },
         {"type": "sphere", "name": "ball", "position": [0, 0, 1], "orientation_xyzw": [0, 0, 0, 1], "radius": 0.2},
     ],
 }
@@ -46,8 +61,14 @@ def test_load_and_reorder_joints(tmp_path):
     np.testing.assert_array_equal(obstacles[0].pose[:3, 3], [1, 0, 0])
 
 
-@pytest.mark.parametrize("drop, name", [(("goals",), "goals"), (("obstacles", 1, "radius"), "radius"),
-                                        (("obstacles", 0, "orientation_xyzw"), "orientation_xyzw")])
+@pytest.mark.parametrize(
+    "drop, name",
+    [
+        (("goals",), "goals"),
+        (("obstacles", 1, "radius"), "radius"),
+        (("obstacles", 0, "orientation_xyzw"), "orientation_xyzw"),
+    ],
+)
 def test_missing_field_is_named(tmp_path, drop, name):
     with pytest.raises(ValueError, match=f"problem 7.*'{name}'"):
         load_mbm(write(tmp_path, drop=drop))
@@ -63,10 +84,10 @@ def test_bad_values(tmp_path):
     with pytest.raises(ValueError, match="start"):
         load_mbm(write(tmp_path, problem=bad))
     bad = dict(PROBLEM, obstacles=[dict(PROBLEM["obstacles"][0], type="cone")])
-    with pytest.raises(ValueError, match="'table'.*cone"):
+    with pytest.raises(ValueError, match=r"'table'.*cone"):
         load_mbm(write(tmp_path, problem=bad))
     (tmp_path / "broken.json").write_text("{")
-    with pytest.raises(ValueError, match="broken.json"):
+    with pytest.raises(ValueError, match=r"broken\.json"):
         load_mbm(tmp_path / "broken.json")
 
 
@@ -84,4 +105,6 @@ def test_starts_and_goals_valid_with_vamp_panda(scenario):
             bad_start.append(problem.id)
         if not checker.check(problem.goals).any():
             no_goal.append(problem.id)
-    assert not bad_start and not no_goal, f"{scenario}: invalid starts {bad_start}, problems without a valid goal {no_goal}"
+    assert not bad_start and not no_goal, (
+        f"{scenario}: invalid starts {bad_start}, problems without a valid goal {no_goal}"
+    )

@@ -17,9 +17,16 @@ import math
 import os
 
 import pytest
+from acceptance import (
+    MAP_RUNS,
+    STOCK,
+    package_planners,
+    run_2d_circles_test,
+    run_2d_map_test,
+    simple_test,
+    termination_test,
+)
 from ompl import util as ou
-
-from acceptance import MAP_RUNS, STOCK, package_planners, run_2d_circles_test, run_2d_map_test, simple_test, termination_test
 from ompl_envs import RESOURCES, load_circles, load_environment, load_queries
 
 ou.setLogLevel(ou.LOG_ERROR)  # as TestPlanner's constructor
@@ -79,7 +86,7 @@ def test_termination(entry, env):
     """Nothing but the query states is valid: ``solve(0.1)`` returns promptly, unsolved."""
     elapsed, solved = termination_test(entry, env, limit=0.1)
     assert not solved
-    assert elapsed < 0.5, f"solve(0.1) took {elapsed:.3f} s with nothing valid to sample"
+    assert elapsed < 0.5, f"solve(0.1) took {elapsed:.3f} s of CPU time with nothing valid to sample"
 
 
 @pytest.mark.parametrize("test", ["2D map", "2D circles"])
@@ -94,8 +101,10 @@ def test_circle_buckets_answer_as_every_circle(circles):
 
     obstacles, _ = circles
     rng = random.Random(4)
-    points = [(rng.uniform(obstacles.min_x, obstacles.max_x), rng.uniform(obstacles.min_y, obstacles.max_y))
-              for _ in range(20000)]
+    points = [
+        (rng.uniform(obstacles.min_x, obstacles.max_x), rng.uniform(obstacles.min_y, obstacles.max_y))
+        for _ in range(20000)
+    ]
     for x, y, r in obstacles.circles:  # on, just inside and just outside every circle
         for k in range(16):
             angle = 2 * 3.141592653589793 * k / 16

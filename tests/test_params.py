@@ -34,7 +34,9 @@ def test_types_are_inferred_and_values_are_strings(params_and_holder):
     assert params.setParam("mode", "b") and holder.mode == "b"
 
 
-@pytest.mark.parametrize(("text", "value"), [("0", False), ("1", True), ("true", True), ("false", False), ("TRUE", True)])
+@pytest.mark.parametrize(
+    ("text", "value"), [("0", False), ("1", True), ("true", True), ("false", False), ("TRUE", True)]
+)
 def test_booleans_in_ompl_forms(params_and_holder, text, value):
     params, holder = params_and_holder
     assert params.setParam("flag", text)
@@ -51,11 +53,19 @@ def test_range_suggestions(params_and_holder):
 
 @pytest.mark.parametrize(
     ("name", "text"),
-    [("ratio", "abc"), ("ratio", "-1"), ("ratio", "nan"), ("ratio", "inf"), ("flag", "yes"), ("count", "2.5"),
-     ("mode", "c"), ("unknown", "1")],
+    [
+        ("ratio", "abc"),
+        ("ratio", "-1"),
+        ("ratio", "nan"),
+        ("ratio", "inf"),
+        ("flag", "yes"),
+        ("count", "2.5"),
+        ("mode", "c"),
+        ("unknown", "1"),
+    ],
 )
 def test_refusals_return_false_and_change_nothing(params_and_holder, name, text):
-    params, holder = params_and_holder
+    params, _holder = params_and_holder
     before = params.getParams()
     assert params.setParam(name, text) is False
     assert params.getParams() == before

@@ -2,19 +2,20 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 
 import pytest
+from fresh_process import run_with_seed
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import tools as ot
 from ompl import util as ou
+from pathcheck import assert_valid_solution
 
 from ompl_balance import BalancedRRTConnect, balance_choice, read_work, tree_size_ratio
 from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, get_problem
-from fresh_process import run_with_seed
-from pathcheck import assert_valid_solution
 
 ou.setLogLevel(ou.LOG_WARN)
 
@@ -102,13 +103,13 @@ def start_states(problem, ss):
 
 def goal_test_for(ss):
     goal = ss.getGoal()
-    return lambda state: goal.isSatisfied(state)
+    return goal.isSatisfied
 
 
 @pytest.mark.parametrize("name", list(PROBLEMS))
 @pytest.mark.parametrize("balance", [True, False])
 def test_solves_builtin_problems_with_valid_paths(name, balance):
-    problem, ss, planner, status = solve_problem(name, lambda p: p.setBalanceTreeSizes(balance))
+    problem, ss, _planner, status = solve_problem(name, lambda p: p.setBalanceTreeSizes(balance))
     assert status == ob.PlannerStatus.EXACT_SOLUTION
     assert_valid_solution(ss, problem.world(), start_states(problem, ss), goal_test_for(ss))
 
@@ -120,7 +121,7 @@ def test_intermediate_states_paths_are_valid():
     is valid at the resolution when each vertex is valid and consecutive vertices are
     at most one validity-checking segment apart.
     """
-    problem, ss, planner, status = solve_problem("narrow_gap", lambda p: p.setIntermediateStates(True))
+    problem, ss, _planner, status = solve_problem("narrow_gap", lambda p: p.setIntermediateStates(True))
     assert status == ob.PlannerStatus.EXACT_SOLUTION
     si = ss.getSpaceInformation()
     path = ss.getSolutionPath()
@@ -129,7 +130,7 @@ def test_intermediate_states_paths_are_valid():
     assert all(world(state) for state in states)
     assert si.distance(states[0], start_states(problem, ss)[0]) < 1e-12 and goal_test_for(ss)(states[-1])
     longest = si.getStateSpace().getLongestValidSegmentLength()
-    assert max(si.distance(a, b) for a, b in zip(states, states[1:])) <= longest * (1 + 1e-9)
+    assert max(si.distance(a, b) for a, b in itertools.pairwise(states)) <= longest * (1 + 1e-9)
 
 
 def boxes_7d():
@@ -256,7 +257,7 @@ def test_ompl_benchmark_runs_and_logs_our_planner(tmp_path):
 
 
 def test_simple_setup_get_planner_data_does_not_crash_and_plannerdata_has_both_trees():
-    problem, ss, planner, status = solve_problem("bug_trap")
+    _problem, ss, planner, _status = solve_problem("bug_trap")
     data = ob.PlannerData(ss.getSpaceInformation())
     ss.getPlannerData(data)  # would abort the process if the planner defined getPlannerData
     assert data.numVertices() == 0
@@ -308,7 +309,7 @@ def test_goal_in_collision_is_invalid_goal():
 
 
 def test_impossible_problem_times_out_on_time():
-    walled = get_problem("narrow_gap").boxes[0][:3] + (1.0,)  # close the gap
+    walled = (*get_problem("narrow_gap").boxes[0][:3], 1.0)  # close the gap
     world = BoxWorld2D((walled,))
     ss = get_problem("narrow_gap").setup()
     ss.setStateValidityChecker(world)
@@ -320,9 +321,28 @@ def test_impossible_problem_times_out_on_time():
     elapsed = time.perf_counter() - began
     assert status == ob.PlannerStatus.TIMEOUT
     assert not ss.haveSolutionPath()
-    # one iteration of this planner takes well under 50 ms
-    assert elapsed < 0.2 + 0.05
     assert planner.stats.iterations > 10
+    # The time limit is honoured (a bound no loaded machine reaches; the exact claim, one
+    # check of the condition per iteration, is the next test's).
+    assert elapsed < 0.2 + 2.0
+
+
+def test_the_termination_condition_is_checked_once_per_iteration():
+    walled = (*get_problem("narrow_gap").boxes[0][:3], 1.0)
+    ss = get_problem("narrow_gap").setup()
+    ss.setStateValidityChecker(BoxWorld2D((walled,)))
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    ss.setup()
+    asked = 0
+
+    def stop_after_50() -> bool:
+        nonlocal asked
+        asked += 1
+        return asked > 50
+
+    assert planner.solve(stop_after_50) == ob.PlannerStatus.TIMEOUT
+    assert planner.stats.iterations == 50 and asked == 51
 
 
 def test_multiple_start_states_and_goal_states():
@@ -364,7 +384,7 @@ def test_clear_then_solve_again():
 
 
 def test_stats_count_the_work_of_one_solve():
-    problem, ss, planner, status = solve_problem("narrow_gap")
+    _problem, ss, planner, _status = solve_problem("narrow_gap")
     stats = planner.stats
     assert stats.status == "Exact solution"
     assert stats.iterations >= 1 and stats.time > 0
@@ -409,8 +429,15 @@ def test_every_parameter_round_trips():
 
 @pytest.mark.parametrize(
     ("name", "value"),
-    [("no_such_param", "1"), ("max_tree_size_ratio", "abc"), ("max_tree_size_ratio", "-0.5"),
-     ("range", "-1"), ("balance_tree_sizes", "maybe"), ("seed", "-3"), ("seed", "1.5")],
+    [
+        ("no_such_param", "1"),
+        ("max_tree_size_ratio", "abc"),
+        ("max_tree_size_ratio", "-0.5"),
+        ("range", "-1"),
+        ("balance_tree_sizes", "maybe"),
+        ("seed", "-3"),
+        ("seed", "1.5"),
+    ],
 )
 def test_bad_parameters_are_refused_and_change_nothing(name, value):
     planner = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation())
@@ -449,7 +476,7 @@ def test_same_seed_same_path_in_a_fresh_process():
 def test_two_solves_in_one_process_differ():
     paths = []
     for _ in range(2):
-        problem, ss, planner, status = solve_problem("maze")
+        _problem, ss, _planner, _status = solve_problem("maze")
         path = ss.getSolutionPath()
         paths.append([path.getState(i)[j] for i in range(path.getStateCount()) for j in range(2)])
     assert paths[0] != paths[1]
@@ -458,7 +485,7 @@ def test_two_solves_in_one_process_differ():
 def test_fixed_seed_parameter_repeats_the_path_in_one_process():
     paths = []
     for _ in range(2):
-        problem, ss, planner, status = solve_problem("maze", lambda p: p.setSeed(123))
+        _problem, ss, _planner, _status = solve_problem("maze", lambda p: p.setSeed(123))
         path = ss.getSolutionPath()
         paths.append([path.getState(i)[j] for i in range(path.getStateCount()) for j in range(2)])
     assert paths[0] == paths[1]

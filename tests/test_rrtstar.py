@@ -10,12 +10,12 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import tools as ot
 from ompl import util as ou
+from pathcheck import assert_valid_solution
 
 from ompl_balance.gamma import ball_radius_constant
-from ompl_balance.worlds.occupancy import rooms_problem
 from ompl_balance.rrtstar import BallRadiusRRTstar
 from ompl_balance.worlds.boxes import get_problem
-from pathcheck import assert_valid_solution
+from ompl_balance.worlds.occupancy import rooms_problem
 
 ou.setLogLevel(ou.LOG_WARN)
 
@@ -51,7 +51,9 @@ def test_se2_rooms_path_is_valid():
     problem = rooms_problem(se2=True)
     ss = problem.setup()
     # SE(2) runs on OMPL's sampler (the seed parameter does not apply): stop at the first path
-    planner = _planner(ss, max_connection_distance="6", max_iterations="0", goal_bias="0.2", continue_after_goal_reached="0")
+    planner = _planner(
+        ss, max_connection_distance="6", max_iterations="0", goal_bias="0.2", continue_after_goal_reached="0"
+    )
     assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
     si = ss.getSpaceInformation()
     start, goal = si.allocState(), si.allocState()
@@ -94,13 +96,17 @@ def test_estimated_gamma_beats_the_default_of_100_at_equal_iterations():
         costs = []
         for seed in range(1, 11):
             ss = problem.setup()
-            planner = _planner(ss, ball_radius_constant=gamma, max_connection_distance="4", max_iterations="1000", seed=str(seed))
+            planner = _planner(
+                ss, ball_radius_constant=gamma, max_connection_distance="4", max_iterations="1000", seed=str(seed)
+            )
             ss.solve(60.0)
             assert planner.stats.iterations == 1000
             costs.append(planner.stats.best_cost)
         final[gamma] = costs
     # the estimate is close to gamma* of the exact free area
-    assert planner.getBallRadiusConstantInUse() == pytest.approx(ball_radius_constant(2, problem.grid.free_area), rel=0.05)
+    assert planner.getBallRadiusConstantInUse() == pytest.approx(
+        ball_radius_constant(2, problem.grid.free_area), rel=0.05
+    )
     assert np.median(final["auto"]) < np.median(final["100"]), final
 
 
@@ -116,7 +122,9 @@ def test_cost_threshold_stops_at_the_first_solution():
 
 def test_not_continuing_after_the_goal_stops_at_the_first_solution():
     ss = rooms_problem().setup()
-    planner = _planner(ss, max_connection_distance="4", max_iterations="3000", seed="3", continue_after_goal_reached="0")
+    planner = _planner(
+        ss, max_connection_distance="4", max_iterations="3000", seed="3", continue_after_goal_reached="0"
+    )
     assert ss.solve(30.0)
     assert planner.stats.iterations == planner.stats.first_solution_iteration
 
@@ -138,7 +146,9 @@ def test_same_seed_same_run():
     runs = []
     for _ in range(2):
         ss = rooms_problem().setup()
-        planner = _planner(ss, max_connection_distance="4", max_iterations="300", seed="11", ball_radius_constant="auto")
+        planner = _planner(
+            ss, max_connection_distance="4", max_iterations="300", seed="11", ball_radius_constant="auto"
+        )
         ss.solve(30.0)
         runs.append((planner.getBallRadiusConstantInUse(), planner.stats.best_costs, planner.stats.states_checked))
     assert runs[0][0] == runs[1][0] and runs[0][2] == runs[1][2]

@@ -6,13 +6,13 @@ import math
 
 import numpy as np
 import pytest
+from fresh_process import run_with_seed
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ompl_balance.worlds.boxes import BoxWorld2D, get_problem
 from ompl_balance.samplers import BridgeTestValidStateSampler, GaussianValidStateSampler, PassageSampler
-from fresh_process import run_with_seed
+from ompl_balance.worlds.boxes import BoxWorld2D, get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
 SAMPLERS = [GaussianValidStateSampler, BridgeTestValidStateSampler, PassageSampler]
@@ -126,23 +126,29 @@ def test_sample_near_stays_near_and_valid(sampler_class):
 
 
 class CountingBridge(BridgeTestValidStateSampler):
-    """Counts the samples C++ asks for (in a class attribute: no reference to the instance)."""
+    """Counts the samples C++ asks for and those found (class attributes: no reference to the instance)."""
 
-    samples = 0
+    samples = found = 0
 
     def sample(self, state):
         CountingBridge.samples += 1
-        return super().sample(state)
+        found = super().sample(state)
+        CountingBridge.found += found
+        return found
 
 
-def test_prm_uses_a_python_sampler_through_the_allocator():
-    problem = get_problem("narrow_gap")
-    ss = problem.setup()
+def test_prm_grows_its_roadmap_from_a_python_sampler_given_through_the_allocator():
+    """PRM's roadmap growth (in this thread, as ``growRoadmap`` runs it) asks the Python sampler
+    for every milestone: each sample found is a milestone, and nothing else is."""
+    ss = get_problem("narrow_gap").setup()
     ss.getSpaceInformation().setValidStateSamplerAllocator(CountingBridge)
-    ss.setPlanner(og.PRM(ss.getSpaceInformation()))
-    CountingBridge.samples = 0
-    assert ss.solve(5.0)
+    prm = og.PRM(ss.getSpaceInformation())
+    ss.setPlanner(prm)
+    ss.setup()
+    CountingBridge.samples = CountingBridge.found = 0
+    prm.growRoadmap(0.2)
     assert CountingBridge.samples > 0
+    assert prm.milestoneCount() == CountingBridge.found > 0
 
 
 def test_parameters_are_checked():
@@ -153,7 +159,12 @@ def test_parameters_are_checked():
     assert (sampler.getNeighbours(), sampler.getMinColliding(), sampler.getMaxColliding()) == (8, 1, 7)
     params = sampler.params()
     assert params.setParam("standard_deviation", "0.02") and sampler.getStdDev() == 0.02
-    for name, value in (("standard_deviation", "0"), ("min_colliding", "8"), ("max_colliding", "9"), ("neighbours", "0")):
+    for name, value in (
+        ("standard_deviation", "0"),
+        ("min_colliding", "8"),
+        ("max_colliding", "9"),
+        ("neighbours", "0"),
+    ):
         assert params.setParam(name, value) is False, name
     with pytest.raises(ValueError, match="min_colliding <= max_colliding"):
         PassageSampler(si, neighbours=4, min_colliding=3, max_colliding=2)

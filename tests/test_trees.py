@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
+from fresh_process import run_with_seed
 from ompl import base as ob
 
-from fresh_process import run_with_seed
 from ompl_balance.core.trees import NO_PARENT, ArrayTree, StateTree
 
 

@@ -10,10 +10,10 @@ import yourdfpy
 from ompl import base as ob
 from ompl import geometric as og
 
-from ompl_balance.core.counting import read_work
-from ompl_balance.collision.kinematics import RobotModel
 from ompl_balance.collision.checker import CollisionChecker, Environment
+from ompl_balance.collision.kinematics import RobotModel
 from ompl_balance.collision.robots import PANDA_VAMP_DIR, load_panda_vamp
+from ompl_balance.core.counting import read_work
 from ompl_balance.validity import MotionValidator, StateValidityChecker, coarse_to_fine, setup_robot, space_for
 from ompl_balance.worlds.mbm import load_mbm
 
@@ -42,8 +42,10 @@ def independent_answers(robot, environment, urdf_path, q):
     collisions = [(link.name, c) for link in urdf.robot.links for c in link.collisions]
     assert [name for name, _ in collisions] == [g.link for g in robot.geometries]
     request = fcl.CollisionRequest()
-    obstacles = [fcl.CollisionObject(o.shape.fcl_geometry(), fcl.Transform(o.pose[:3, :3], o.pose[:3, 3]))
-                 for o in environment.obstacles]
+    obstacles = [
+        fcl.CollisionObject(o.shape.fcl_geometry(), fcl.Transform(o.pose[:3, :3], o.pose[:3, 3]))
+        for o in environment.obstacles
+    ]
     root = robot.link_names[0]
     env_hits, self_hits = [], []
     for x in q:
@@ -54,8 +56,12 @@ def independent_answers(robot, environment, urdf_path, q):
             pose = urdf.get_transform(link, root) @ origin
             objects.append(fcl.CollisionObject(geometry.shape.fcl_geometry(), fcl.Transform(pose[:3, :3], pose[:3, 3])))
         env_hits.append(any(fcl.collide(a, b, request, fcl.CollisionResult()) for a in objects for b in obstacles))
-        self_hits.append(any(fcl.collide(objects[i], objects[j], request, fcl.CollisionResult())
-                             for i, j in robot.self_collision_pairs))
+        self_hits.append(
+            any(
+                fcl.collide(objects[i], objects[j], request, fcl.CollisionResult())
+                for i, j in robot.self_collision_pairs
+            )
+        )
     return np.array(env_hits), np.array(self_hits)
 
 
@@ -98,7 +104,7 @@ def test_certified_free_tables_hold_no_contact_panda():
         if k < 0:
             continue
         rows, cols = volumes.table_cells[k]
-        free = volumes.table_free[volumes.table_start[k]:volumes.table_start[k] + rows * cols].reshape(rows, cols)
+        free = volumes.table_free[volumes.table_start[k] : volumes.table_start[k] + rows * cols].reshape(rows, cols)
         assert 0.5 < free.mean() < 1.0  # certifies most, not what it cannot
         padded = np.pad(free, 1, constant_values=True)
         border = free & ~(padded[:-2, 1:-1] & padded[2:, 1:-1] & padded[1:-1, :-2] & padded[1:-1, 2:])
@@ -153,9 +159,9 @@ def check_motion_validator(robot, environment, edges_count, seed):
     rng = np.random.default_rng(seed)
     checker = CollisionChecker(robot, environment)
     space, si = make_si(robot, checker)
-    validity, motion = setup_robot(si, checker)
+    _validity, motion = setup_robot(si, checker)
     si.setup()
-    discrete_space, discrete_si = make_si(robot, checker)
+    _discrete_space, discrete_si = make_si(robot, checker)
     discrete_si.setStateValidityChecker(StateValidityChecker(discrete_si, CollisionChecker(robot, environment)))
     discrete_si.setup()
     s1, s2, last = si.allocState(), si.allocState(), si.allocState()
@@ -177,7 +183,7 @@ def check_motion_validator(robot, environment, edges_count, seed):
         if not valid:
             first = int(np.argmin(walk))
             assert fraction == pytest.approx(first / nd)
-            np.testing.assert_allclose(last[0:robot.dof], a + first / nd * (b - a), atol=1e-12)
+            np.testing.assert_allclose(last[0 : robot.dof], a + first / nd * (b - a), atol=1e-12)
         outcomes.append(valid)
     assert 3 <= sum(outcomes) <= len(outcomes) - 3, "edges should be both free and colliding"
 
@@ -228,7 +234,7 @@ def test_bad_input():
     checker = CollisionChecker(robot, environment)
     with pytest.raises(ValueError, match="'slide'"):
         checker.check([0.0, 0.0, np.inf])
-    space, si = make_si(robot, checker)
+    _space, si = make_si(robot, checker)
     validity = StateValidityChecker(si, checker)
     state = si.allocState()
     state[0], state[1], state[2] = 0.0, float("nan"), 0.0
@@ -238,7 +244,7 @@ def test_bad_input():
         setup_robot(ob.SpaceInformation(ob.RealVectorStateSpace(2)), checker)
     with pytest.raises(ValueError, match="'wall'"):
         environment.add_box("wall", [1, 1, 1])
-    with pytest.raises(ValueError, match="'tilted'.*quaternion"):
+    with pytest.raises(ValueError, match=r"'tilted'.*quaternion"):
         environment.add_box("tilted", [1, 1, 1], orientation_xyzw=[0, 0, 1, 1])
     with pytest.raises(ValueError, match="positive"):
         environment.add_sphere("flat", 0.0)

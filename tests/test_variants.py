@@ -10,8 +10,9 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import tools as ot
 from ompl import util as ou
+from pathcheck import assert_valid_solution
 
-import ompl_balance.planners as planners
+from ompl_balance import planners
 from ompl_balance.planners import PRESETS, BalancedRRTConnect, Extender, GaussianPassageRRTConnect, Grow
 from ompl_balance.policies import (
     SAMPLE_POLICIES,
@@ -24,11 +25,10 @@ from ompl_balance.policies import (
     node_quality,
     tree_chooser,
 )
+from ompl_balance.samplers import GaussianValidStateSampler
+from ompl_balance.worlds.boxes import get_problem
 
 ALTERNATE, BALANCE, STEPS, COLLISION = SwapCause
-from ompl_balance.worlds.boxes import get_problem
-from ompl_balance.samplers import GaussianValidStateSampler
-from pathcheck import assert_valid_solution
 
 ou.setLogLevel(ou.LOG_WARN)
 
@@ -55,7 +55,9 @@ def test_balancing_is_the_balancing_rule_else_the_swap_policy():
 def test_balance_steps_swaps_exactly_at_swap_steps():
     choose = tree_chooser("balance_steps", swap_steps=4)
     for grew_start in (True, False):
-        assert [choose(grew_start, 5, 500, steps, True)[0] for steps in range(7)] == [grew_start] * 4 + [not grew_start] * 3
+        assert [choose(grew_start, 5, 500, steps, True)[0] for steps in range(7)] == [grew_start] * 4 + [
+            not grew_start
+        ] * 3
     assert choose(True, 1, 1, 4, False)[1] == STEPS
 
 
@@ -164,7 +166,9 @@ def replay_swaps(events):
 
 
 def test_balance_steps_swaps_after_exactly_swap_steps_connect_steps(monkeypatch):
-    ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="balance_steps", swap_steps=3, balance_tree_sizes=0)
+    _ss, planner, events = traced_run(
+        monkeypatch, "bug_trap", swap_policy="balance_steps", swap_steps=3, balance_tree_sizes=0
+    )
     decisions = replay_swaps(events)
     assert len(decisions) > 20
     for grew_start, grow_start, steps, _ in decisions:
@@ -176,7 +180,7 @@ def test_balance_steps_swaps_after_exactly_swap_steps_connect_steps(monkeypatch)
 
 
 def test_on_collision_never_swaps_after_a_collision_free_connect(monkeypatch):
-    ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="on_collision", balance_tree_sizes=0)
+    _ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="on_collision", balance_tree_sizes=0)
     decisions = replay_swaps(events)
     swaps = [(grew, grow, collided) for grew, grow, _, collided in decisions]
     assert any(grew != grow for grew, grow, _ in swaps)
@@ -199,7 +203,7 @@ def extension_targets(events):
 
 def test_goal_ball_never_targets_farther_from_the_goal_than_the_start(monkeypatch):
     problem = get_problem("bug_trap")
-    ss, planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_ball")
+    _ss, planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_ball")
     start, goal = np.array(problem.start), np.array(problem.goal)
     radius = np.linalg.norm(goal - start)
     targets = extension_targets(events)
@@ -212,7 +216,7 @@ def test_goal_ball_never_targets_farther_from_the_goal_than_the_start(monkeypatc
 
 def test_goal_bias_targets_the_other_root_at_the_given_rate(monkeypatch):
     problem = get_problem("bug_trap")
-    ss, planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_bias", goal_bias=0.5, seed=5)
+    _ss, _planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_bias", goal_bias=0.5, seed=5)
     roots = {True: np.array(problem.goal), False: np.array(problem.start)}
     targets = extension_targets(events)
     at_root = [np.array_equal(target, roots[grow_start]) for grow_start, target in targets]
@@ -247,14 +251,14 @@ def test_exhausted_policy_never_extends_an_exhausted_node(monkeypatch):
 
 
 def test_failed_extensions_are_counted_per_node(monkeypatch):
-    ss, planner, events = traced_run(monkeypatch, "bug_trap", nearest_policy="exhaustion")
+    _ss, planner, events = traced_run(monkeypatch, "bug_trap", nearest_policy="exhaustion")
     trapped = sum(1 for e in events if e[0] == "grow" and e[4] is Grow.TRAPPED)
     recorded = sum(int(failures.counts(len(tree)).sum()) for tree, failures in planner._failures.items())
     assert trapped > 0 and recorded == trapped
 
 
 def test_euclidean_policy_counts_no_failures(monkeypatch):
-    ss, planner, events = traced_run(monkeypatch, "bug_trap")
+    _ss, planner, _events = traced_run(monkeypatch, "bug_trap")
     assert all(int(f.counts(len(t)).sum()) == 0 for t, f in planner._failures.items())
 
 
@@ -431,5 +435,5 @@ def test_valid_sampler_with_a_fixed_seed_is_refused_at_setup():
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     assert planner.params().setParams({"sample_policy": "valid_sampler", "seed": "3"})
     ss.setPlanner(planner)
-    with pytest.raises(ValueError, match="valid_sampler.*seed"):
+    with pytest.raises(ValueError, match=r"valid_sampler.*seed"):
         ss.setup()

@@ -23,9 +23,9 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from ..worlds.boxes import PROBLEMS
 from .experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec
 from .logs import to_database, write_logs
-from ..worlds.boxes import PROBLEMS
 from .runner import Progress, Record, ResultStore, sweep
 from .summary import format_csv, format_markdown, summarize
 
@@ -37,7 +37,9 @@ def default_planners() -> list[PlannerSpec]:
     return [
         PlannerSpec(STOCK_LABEL, STOCK_LABEL),
         PlannerSpec("BalancedRRTConnect", "BalancedRRTConnect"),
-        PlannerSpec("BalancedRRTConnect[balance_tree_sizes=0]", "BalancedRRTConnect", params={"balance_tree_sizes": "0"}),
+        PlannerSpec(
+            "BalancedRRTConnect[balance_tree_sizes=0]", "BalancedRRTConnect", params={"balance_tree_sizes": "0"}
+        ),
     ]
 
 
@@ -57,8 +59,13 @@ def parse_planners(text: str) -> list[PlannerSpec]:
     return specs
 
 
-def compare_experiment(problems: Sequence[str] = tuple(PROBLEMS), planners: Sequence[PlannerSpec] | None = None,
-                       runs: int = 20, time_limit: float = 5.0, seed: int | None = None) -> Experiment:
+def compare_experiment(
+    problems: Sequence[str] = tuple(PROBLEMS),
+    planners: Sequence[PlannerSpec] | None = None,
+    runs: int = 20,
+    time_limit: float = 5.0,
+    seed: int | None = None,
+) -> Experiment:
     """The ``ompl-balance compare`` experiment: built-in problems, stock RRTConnect as the baseline.
 
     ``seed=None`` draws one (it is recorded in ``experiment.json`` and the logs).
@@ -83,8 +90,9 @@ def _claim(out: Path, experiment: Experiment) -> None:
         mine, theirs = experiment.results_identity(), previous.results_identity()
         differing = sorted(key for key in mine if mine[key] != theirs.get(key))
         if differing:
-            raise ExperimentError(str(out), f"holds results of an experiment with other {', '.join(differing)}; "
-                                            "use another output folder")
+            raise ExperimentError(
+                str(out), f"holds results of an experiment with other {', '.join(differing)}; use another output folder"
+            )
     out.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(experiment.as_dict(), indent=1))
 
@@ -107,7 +115,9 @@ def experiment_records(experiment: Experiment, store: ResultStore) -> list[Recor
     return [r for r in store.records() if (r["problem"], r["planner"], r["run"]) in keys]
 
 
-def bench(experiment: Experiment, out: str | Path, jobs: int = 1, dask: str | None = None, progress: bool = True) -> list[Record]:
+def bench(
+    experiment: Experiment, out: str | Path, jobs: int = 1, dask: str | None = None, progress: bool = True
+) -> list[Record]:
     """Run what is missing of ``experiment`` into ``out`` and write the logs, database and summary.
 
     ``jobs`` runs at a time on this machine, or on the Dask cluster ``dask``. Returns
@@ -117,8 +127,14 @@ def bench(experiment: Experiment, out: str | Path, jobs: int = 1, dask: str | No
     _claim(out, experiment)
     store = ResultStore(out / "results.jsonl")
     total = len(experiment.tasks())
-    bar = tqdm(total=total, initial=len(experiment_records(experiment, store)), disable=not progress, unit="run",
-               smoothing=0.1, dynamic_ncols=True)
+    bar = tqdm(
+        total=total,
+        initial=len(experiment_records(experiment, store)),
+        disable=not progress,
+        unit="run",
+        smoothing=0.1,
+        dynamic_ncols=True,
+    )
 
     def show(record: Record, counts: Progress) -> None:
         bar.update(1)

@@ -219,7 +219,9 @@ class PlannerSpec:
             return
         known = {**stock_planner_classes(), **package_planner_classes()}
         if self.name not in known:
-            raise ExperimentError("name", f"unknown planner {self.name!r}; known: {', '.join(sorted(known))}", self.name)
+            raise ExperimentError(
+                "name", f"unknown planner {self.name!r}; known: {', '.join(sorted(known))}", self.name
+            )
         space = ob.RealVectorStateSpace(2)
         space.setBounds(0.0, 1.0)
         si = ob.SpaceInformation(space)
@@ -376,37 +378,63 @@ class Experiment:
 def check_experiment(experiment: Experiment) -> None:
     """Raise :class:`ExperimentError` naming the offending key for anything that cannot run."""
     if not re.fullmatch(r"[A-Za-z0-9_.\-]+", experiment.name):
-        raise ExperimentError("name", f"{experiment.name!r} must be letters, digits, '_', '.', '-' (it names the OMPL logs)")
+        raise ExperimentError(
+            "name", f"{experiment.name!r} must be letters, digits, '_', '.', '-' (it names the OMPL logs)"
+        )
     if isinstance(experiment.runs, bool) or not isinstance(experiment.runs, int) or experiment.runs < 1:
         raise ExperimentError("runs", f"must be a whole number >= 1, got {experiment.runs!r}")
     for key in ("time_limit", "memory_limit", "hard_limit_margin"):
         value = getattr(experiment, key)
         positive = key == "time_limit"
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value > 0 if positive else value >= 0) or value == float("inf"):
-            raise ExperimentError(key, f"must be a {'positive' if positive else 'non-negative'} finite number, got {value!r}")
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not (value > 0 if positive else value >= 0)
+            or value == float("inf")
+        ):
+            raise ExperimentError(
+                key, f"must be a {'positive' if positive else 'non-negative'} finite number, got {value!r}"
+            )
     if isinstance(experiment.seed, bool) or not isinstance(experiment.seed, int) or experiment.seed < 0:
         raise ExperimentError("seed", f"must be a whole number >= 0, got {experiment.seed!r}")
     if not experiment.problems:
         raise ExperimentError("problems", "the experiment has none")
     if not experiment.planners:
         raise ExperimentError("planners", "the experiment has none")
-    for key, names in (("problems", [p.name for p in experiment.problems]), ("planners", [p.label for p in experiment.planners])):
+    for key, names in (
+        ("problems", [p.name for p in experiment.problems]),
+        ("planners", [p.label for p in experiment.planners]),
+    ):
         duplicates = sorted({n for n in names if names.count(n) > 1})
         if duplicates:
             raise ExperimentError(key, f"names and labels must be unique, repeated: {', '.join(duplicates)}")
     labels = [p.label for p in experiment.planners]
     if experiment.baseline and experiment.baseline not in labels:
-        raise ExperimentError("baseline", f"{experiment.baseline!r} is not a planner label; labels: {', '.join(labels)}")
+        raise ExperimentError(
+            "baseline", f"{experiment.baseline!r} is not a planner label; labels: {', '.join(labels)}"
+        )
     for index, planner in enumerate(experiment.planners):
         try:
             planner.check()
         except ExperimentError as error:
-            raise ExperimentError(f"planners[{index}].{error.key}", str(error).partition(": ")[2], error.value) from error
+            raise ExperimentError(
+                f"planners[{index}].{error.key}", str(error).partition(": ")[2], error.value
+            ) from error
 
 
 # -- TOML -------------------------------------------------------------------------------
 
-_TOP_KEYS = {"name", "runs", "time_limit", "memory_limit", "seed", "baseline", "hard_limit_margin", "problems", "planners"}
+_TOP_KEYS = {
+    "name",
+    "runs",
+    "time_limit",
+    "memory_limit",
+    "seed",
+    "baseline",
+    "hard_limit_margin",
+    "problems",
+    "planners",
+}
 _PROBLEM_KEYS = {"builtin": set(), "mbm": {"robot", "ids"}, "factory": {"name", "args"}}
 _PLANNER_KEYS = {"name", "factory", "label", "params"}
 
@@ -440,7 +468,9 @@ def load_experiment(path: str | Path) -> Experiment:
         raise ExperimentError(f"{path}{_line_of(text, error.key, error.value)}", str(error), error.value) from error
 
 
-def experiment_from_dict(data: Mapping[str, Any], base_dir: Path = Path("."), default_name: str = "experiment") -> Experiment:
+def experiment_from_dict(
+    data: Mapping[str, Any], base_dir: Path = Path("."), default_name: str = "experiment"
+) -> Experiment:
     """An :class:`Experiment` from the TOML layout (relative paths resolved against ``base_dir``)."""
     unknown = sorted(set(data) - _TOP_KEYS)
     if unknown:
@@ -475,10 +505,17 @@ def _problems(table: Mapping[str, Any], index: int, base_dir: Path) -> list[Prob
     kind = kinds[0]
     unknown = sorted(set(table) - {kind} - _PROBLEM_KEYS[kind])
     if unknown:
-        raise ExperimentError(f"{where}.{unknown[0]}", f"unknown key for a {kind} problem; accepted: {', '.join(sorted(_PROBLEM_KEYS[kind]))}")
+        raise ExperimentError(
+            f"{where}.{unknown[0]}",
+            f"unknown key for a {kind} problem; accepted: {', '.join(sorted(_PROBLEM_KEYS[kind]))}",
+        )
     if kind == "builtin":
         if table["builtin"] not in PROBLEMS:
-            raise ExperimentError(f"{where}.builtin", f"unknown problem {table['builtin']!r}; built-in: {', '.join(PROBLEMS)}", table["builtin"])
+            raise ExperimentError(
+                f"{where}.builtin",
+                f"unknown problem {table['builtin']!r}; built-in: {', '.join(PROBLEMS)}",
+                table["builtin"],
+            )
         return [ProblemSpec(table["builtin"], "builtin", table["builtin"])]
     if kind == "factory":
         try:
@@ -498,8 +535,12 @@ def _mbm_problems(table: Mapping[str, Any], where: str, base_dir: Path) -> list[
     if source not in SCENARIOS:  # a file, relative to the experiment file
         path = (base_dir / source).resolve()
         if not path.is_file():
-            raise ExperimentError(f"{where}.mbm", f"{source!r} is neither a shipped scenario ({', '.join(SCENARIOS)}) "
-                                                  f"nor a file (looked for {str(path)!r})", table["mbm"])
+            raise ExperimentError(
+                f"{where}.mbm",
+                f"{source!r} is neither a shipped scenario ({', '.join(SCENARIOS)}) "
+                f"nor a file (looked for {str(path)!r})",
+                table["mbm"],
+            )
         source = str(path)
     robot = ""  # the Panda shipped with the package
     if "robot" in table:
@@ -521,7 +562,7 @@ def _ids(selection: Any, available: list[int], where: str) -> list[int]:
     if selection == "all":
         return available
     if not isinstance(selection, list) or not selection:
-        raise ExperimentError(where, f"must be \"all\" or a list of ids and \"first-last\" ranges, got {selection!r}")
+        raise ExperimentError(where, f'must be "all" or a list of ids and "first-last" ranges, got {selection!r}')
     ids: list[int] = []
     for item in selection:
         if isinstance(item, int) and not isinstance(item, bool):
@@ -530,7 +571,7 @@ def _ids(selection: Any, available: list[int], where: str) -> list[int]:
             first, last = map(int, item.split("-"))
             ids.extend(range(first, last + 1))
         else:
-            raise ExperimentError(where, f"{item!r} is neither an id nor a \"first-last\" range")
+            raise ExperimentError(where, f'{item!r} is neither an id nor a "first-last" range')
     missing = sorted(set(ids) - set(available))
     if missing:
         raise ExperimentError(where, f"ids {missing} not in the file (it has {min(available)}..{max(available)})")
@@ -550,5 +591,9 @@ def _planner(table: Mapping[str, Any], index: int) -> PlannerSpec:
     label = table.get("label", table.get("name", ""))
     if not label:
         raise ExperimentError(f"{where}.label", "a factory planner needs a label")
-    return PlannerSpec(label=str(label), name=table.get("name", ""), factory=table.get("factory", ""),
-                       params={name: _param_text(value) for name, value in params.items()})
+    return PlannerSpec(
+        label=str(label),
+        name=table.get("name", ""),
+        factory=table.get("factory", ""),
+        params={name: _param_text(value) for name, value in params.items()},
+    )

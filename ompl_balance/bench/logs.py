@@ -20,9 +20,9 @@ import contextlib
 import datetime
 import io
 import platform
-from importlib import metadata
 import socket
 from collections.abc import Iterable, Sequence
+from importlib import metadata
 from pathlib import Path
 
 from ompl import base as ob
@@ -49,16 +49,22 @@ def format_log(experiment: Experiment, problem: str, records: Sequence[Record], 
     """The OMPL log text of ``problem``: its records, grouped by planner in the experiment's order."""
     planners = [p for p in experiment.planners if any(r["planner"] == p.label for r in records)]
     spec = next(p for p in experiment.problems if p.name == problem)
-    setup = (f"problem {problem}: {spec.kind} {spec.source}" + (f" id {spec.problem_id}" if spec.kind == "mbm" else "")
-             + "\n" + "".join(f"planner {p.label}: {p.name or p.factory} {dict(p.params)}\n" for p in planners))
+    setup = (
+        f"problem {problem}: {spec.kind} {spec.source}"
+        + (f" id {spec.problem_id}" if spec.kind == "mbm" else "")
+        + "\n"
+        + "".join(f"planner {p.label}: {p.name or p.factory} {dict(p.params)}\n" for p in planners)
+    )
     lines = [
         f"OMPL version {metadata.version('ompl')}",
         f"Experiment {experiment.name}.{problem}",
         "0 experiment properties",
         f"Running on {socket.gethostname()}",
         f"Starting at {started or datetime.datetime.now().strftime('%Y-%b-%d %H:%M:%S')}",
-        "<<<|", setup + "|>>>",
-        "<<<|", f"{platform.platform()}, {platform.processor() or platform.machine()}\n|>>>",
+        "<<<|",
+        setup + "|>>>",
+        "<<<|",
+        f"{platform.platform()}, {platform.processor() or platform.machine()}\n|>>>",
         f"{experiment.seed} is the random seed",
         f"{experiment.time_limit!r} seconds per run",
         f"{experiment.memory_limit!r} MB per run",

@@ -21,11 +21,11 @@ from pathlib import Path
 import numpy as np
 from ompl import base as ob
 
-from .compare import experiment_records
-from .experiment import Experiment
 from ..core.planner import GOAL_TAG, START_TAG
 from ..planners import BalancedRRTConnect
 from ..worlds.boxes import PROBLEMS
+from .compare import experiment_records
+from .experiment import Experiment
 from .runner import Record, ResultStore
 from .summary import format_csv, format_markdown, pooled_by_scenario, summarize
 
@@ -42,8 +42,10 @@ def _pyplot():
 
 
 def _by_planner(records: Sequence[Record], labels: Sequence[str], name: str) -> list[list[float]]:
-    return [[r["properties"][name] for r in records if r["planner"] == label and r["properties"].get(name) is not None]
-            for label in labels]
+    return [
+        [r["properties"][name] for r in records if r["planner"] == label and r["properties"].get(name) is not None]
+        for label in labels
+    ]
 
 
 def plot_problem(records: Sequence[Record], problem: str, labels: Sequence[str], path: Path) -> Path:
@@ -82,7 +84,7 @@ def plot_success(records: Sequence[Record], experiment: Experiment, path: Path) 
         axis.set_ylim(0, 1.05)
     axes.flat[0].set_ylabel("success rate")
     axes.flat[0].legend(fontsize=7)
-    for axis in list(axes.flat)[len(problems):]:
+    for axis in list(axes.flat)[len(problems) :]:
         axis.set_visible(False)
     figure.tight_layout()
     figure.savefig(path, dpi=120)
@@ -118,14 +120,21 @@ def plot_trees(problem: str, iterations: int, path: Path, seed: int = 1) -> Path
         data, done = grow_trees(problem, balance, iterations, seed)
         for x_min, y_min, x_max, y_max in PROBLEMS[problem].boxes:
             axis.add_patch(plt.Rectangle((x_min, y_min), x_max - x_min, y_max - y_min, color="0.6"))
-        points = np.array([[data.getVertex(i).getState()[0], data.getVertex(i).getState()[1]] for i in range(data.numVertices())])
+        points = np.array(
+            [[data.getVertex(i).getState()[0], data.getVertex(i).getState()[1]] for i in range(data.numVertices())]
+        )
         tags = np.array([data.getVertex(i).getTag() for i in range(data.numVertices())])
         for tag, colour, name in ((START_TAG, "tab:blue", "start tree"), (GOAL_TAG, "tab:orange", "goal tree")):
             for i in np.flatnonzero(tags == tag):
                 for j in data.getEdges(int(i)):
                     axis.plot(points[[i, j], 0], points[[i, j], 1], color=colour, linewidth=0.6)
-            axis.scatter(points[tags == tag, 0], points[tags == tag, 1], s=3, color=colour,
-                         label=f"{name} ({(tags == tag).sum()} states)")
+            axis.scatter(
+                points[tags == tag, 0],
+                points[tags == tag, 1],
+                s=3,
+                color=colour,
+                label=f"{name} ({(tags == tag).sum()} states)",
+            )
         axis.set_xlim(0, 1)
         axis.set_ylim(0, 1)
         axis.set_aspect("equal")
@@ -164,5 +173,7 @@ def plot_folder(out: str | Path, baseline: str | None = None, tree_iterations: i
     written.append(plot_success(records, experiment, folder / "success_vs_time.png"))
     for problem in experiment.problems:
         if problem.kind == "builtin":
-            written.append(plot_trees(problem.source, tree_iterations, folder / f"trees_{problem.name}.png", experiment.seed))
+            written.append(
+                plot_trees(problem.source, tree_iterations, folder / f"trees_{problem.name}.png", experiment.seed)
+            )
     return written

@@ -41,8 +41,11 @@ from ..core.counting import measured_solve
 from .experiment import Experiment, RunTask, planner_params
 
 #: OMPL's planner status names -> the index the OMPL log's ``status`` enum uses.
-STATUS_INDEX = {name: member.value for name, member in ob.PlannerStatus.PlannerStatusType.__members__.items()
-                if name != "TYPE_COUNT"}
+STATUS_INDEX = {
+    name: member.value
+    for name, member in ob.PlannerStatus.PlannerStatusType.__members__.items()
+    if name != "TYPE_COUNT"
+}
 
 Record = dict[str, Any]
 
@@ -88,8 +91,11 @@ def execute(task: RunTask) -> Record:
     planner = task.planner.build(si)
     # This package's planners get the run's seed, unless the experiment sets one or the
     # planner draws from OMPL's RNG (a valid-state sampler), which the setSeed above repeats.
-    run_seeded = ("seed" not in task.planner.params and hasattr(planner, "setSeed")
-                  and not getattr(planner, "draws_from_ompl_rng", False))
+    run_seeded = (
+        "seed" not in task.planner.params
+        and hasattr(planner, "setSeed")
+        and not getattr(planner, "draws_from_ompl_rng", False)
+    )
     if run_seeded:
         planner.setSeed(task.seed)
     ss.setPlanner(planner)
@@ -104,17 +110,23 @@ def execute(task: RunTask) -> Record:
     }
     if ss.haveSolutionPath():
         path = ss.getSolutionPath()  # keep the owner while reading it
-        properties.update([
-            _typed("approximate solution", not ss.haveExactSolutionPath()),
-            _typed("solution length", path.length()),
-            _typed("solution segments", path.getStateCount() - 1),
-        ])
+        properties.update(
+            [
+                _typed("approximate solution", not ss.haveExactSolutionPath()),
+                _typed("solution length", path.length()),
+                _typed("solution segments", path.getStateCount() - 1),
+            ]
+        )
         began = time.perf_counter()
         ss.simplifySolution(task.time_limit)
         properties["simplification time REAL"] = time.perf_counter() - began
         simplified = ss.getSolutionPath()
-        properties.update([_typed("simplified solution length", simplified.length()),
-                           _typed("simplified solution segments", simplified.getStateCount() - 1)])
+        properties.update(
+            [
+                _typed("simplified solution length", simplified.length()),
+                _typed("simplified solution segments", simplified.getStateCount() - 1),
+            ]
+        )
     properties.update(_graph_properties(ss, planner))
     stats = getattr(planner, "stats", None)
     if stats is not None:
@@ -136,7 +148,9 @@ def _status_name(status: ob.PlannerStatus) -> str:
     return "UNKNOWN"
 
 
-def _record(task: RunTask, status: str, properties: dict[str, Any], params: dict[str, str] | None = None, error: str = "") -> Record:
+def _record(
+    task: RunTask, status: str, properties: dict[str, Any], params: dict[str, str] | None = None, error: str = ""
+) -> Record:
     return {
         "problem": task.problem.name,
         "planner": task.planner.label,
@@ -157,7 +171,7 @@ def _child(task: RunTask, connection) -> None:
     ou.setLogLevel(ou.LOG_ERROR)
     try:
         connection.send(execute(task))
-    except BaseException:  # noqa: BLE001 - any failure of the run is its record
+    except BaseException:
         connection.send(_record(task, "CRASH", {}, error=traceback.format_exc(limit=-3)))
 
 
@@ -165,7 +179,12 @@ def _child(task: RunTask, connection) -> None:
 
 # "__main__" too: a run's process then need not re-import the main script (spawn semantics)
 _PRELOAD = ["__main__", "ompl_balance.bench.runner", "ompl_balance.core.scans"]
-_ROBOT_PRELOAD = ["ompl_balance.worlds.mbm", "ompl_balance.collision.robots", "ompl_balance.validity", "ompl_balance.collision.warm_kernels"]
+_ROBOT_PRELOAD = [
+    "ompl_balance.worlds.mbm",
+    "ompl_balance.collision.robots",
+    "ompl_balance.validity",
+    "ompl_balance.collision.warm_kernels",
+]
 
 
 def preload_modules(experiment: Experiment) -> list[str]:
@@ -181,7 +200,9 @@ def _context(preload: list[str]):
 
 def failure_record(task: RunTask, status: str, elapsed: float, error: str) -> Record:
     """The record of a run whose process crashed (``CRASH``) or was killed at its hard limit (``TIMEOUT``)."""
-    return _record(task, status, {"time REAL": elapsed, "status ENUM": STATUS_INDEX[status], "solved BOOLEAN": 0}, error=error)
+    return _record(
+        task, status, {"time REAL": elapsed, "status ENUM": STATUS_INDEX[status], "solved BOOLEAN": 0}, error=error
+    )
 
 
 def run_isolated(task: RunTask, preload: list[str] | None = None) -> Record:
@@ -208,7 +229,9 @@ def run_isolated(task: RunTask, preload: list[str] | None = None) -> Record:
             except EOFError:  # the process died without a word
                 process.join(1.0)
                 return failure_record(task, "CRASH", time.perf_counter() - began, _exit_text(process.exitcode))
-        return failure_record(task, "TIMEOUT", time.perf_counter() - began, f"killed after the hard limit of {task.hard_limit:g} s")
+        return failure_record(
+            task, "TIMEOUT", time.perf_counter() - began, f"killed after the hard limit of {task.hard_limit:g} s"
+        )
     finally:
         receiver.close()
         if process.is_alive():
@@ -306,8 +329,9 @@ def dask_client(address: str):
     if address.startswith("local:"):
         workers = int(address.partition(":")[2])
         with dask.config.set({"distributed.worker.daemon": False}):  # workers start run processes
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   host="127.0.0.1", dashboard_address=None)
+            cluster = LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+            )
         return Client(cluster)
     return Client(address)
 
@@ -322,7 +346,7 @@ def _distributed(tasks: list[RunTask], preload: list[str], address: str) -> Iter
         for future in as_completed(futures):
             try:
                 yield future.result()
-            except Exception as error:  # noqa: BLE001 - e.g. the worker died (KilledWorker)
+            except Exception as error:
                 yield failure_record(futures[future], "CRASH", float("nan"), f"{type(error).__name__}: {error}")
     finally:
         cluster = getattr(client, "cluster", None)

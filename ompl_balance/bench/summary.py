@@ -46,7 +46,9 @@ class Measure:
 NAN_MEASURE = Measure(math.nan, (math.nan, math.nan), math.nan, (math.nan, math.nan))
 
 
-def measure(values: Sequence[float], baseline: Sequence[float], rng: np.random.Generator, is_baseline: bool = False) -> Measure:
+def measure(
+    values: Sequence[float], baseline: Sequence[float], rng: np.random.Generator, is_baseline: bool = False
+) -> Measure:
     """Median of ``values`` and its ratio to the median of ``baseline``, each with a bootstrap 95 % interval.
 
     The baseline's own ratio is exactly 1 (``is_baseline``); no baseline runs give a NaN ratio.
@@ -97,18 +99,28 @@ def summarize(records: Iterable[Record], baseline: str, order: Sequence[str] = (
     for problem, planner in keys:
         runs = cells[problem, planner]
         base = cells.get((problem, baseline), []) if planner != baseline else []
-        summaries.append(CellSummary(
-            problem=problem,
-            planner=planner,
-            runs=len(runs),
-            crashed=sum(bool(r["error"]) for r in runs),
-            success=sum(r["properties"].get("solved BOOLEAN", 0) for r in runs) / len(runs),
-            time=measure(_values(runs, "time REAL"), _values(base, "time REAL"), rng, planner == baseline),
-            checks=measure(_values(runs, "validity checks INTEGER"), _values(base, "validity checks INTEGER"), rng,
-                           planner == baseline),
-            nodes=measure(_values(runs, "graph states INTEGER"), _values(base, "graph states INTEGER"), rng,
-                          planner == baseline),
-        ))
+        summaries.append(
+            CellSummary(
+                problem=problem,
+                planner=planner,
+                runs=len(runs),
+                crashed=sum(bool(r["error"]) for r in runs),
+                success=sum(r["properties"].get("solved BOOLEAN", 0) for r in runs) / len(runs),
+                time=measure(_values(runs, "time REAL"), _values(base, "time REAL"), rng, planner == baseline),
+                checks=measure(
+                    _values(runs, "validity checks INTEGER"),
+                    _values(base, "validity checks INTEGER"),
+                    rng,
+                    planner == baseline,
+                ),
+                nodes=measure(
+                    _values(runs, "graph states INTEGER"),
+                    _values(base, "graph states INTEGER"),
+                    rng,
+                    planner == baseline,
+                ),
+            )
+        )
     return summaries
 
 
@@ -153,7 +165,14 @@ def format_csv(summaries: Sequence[CellSummary]) -> str:
     """The summaries as CSV, one row per cell, intervals as ``_low``/``_high`` columns."""
     columns = ["problem", "planner", "runs", "crashed", "success"]
     for name in ("time", "checks", "nodes"):
-        columns += [f"{name}_median", f"{name}_low", f"{name}_high", f"{name}_ratio", f"{name}_ratio_low", f"{name}_ratio_high"]
+        columns += [
+            f"{name}_median",
+            f"{name}_low",
+            f"{name}_high",
+            f"{name}_ratio",
+            f"{name}_ratio_low",
+            f"{name}_ratio_high",
+        ]
     out = io.StringIO()
     writer = csv.writer(out)
     writer.writerow(columns)

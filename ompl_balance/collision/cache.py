@@ -46,7 +46,9 @@ def digest(parts: Iterable[object]) -> str:
     return h.hexdigest()
 
 
-def cached_arrays(kind: str, key_parts: Iterable[object], compute: Callable[[], dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+def cached_arrays(
+    kind: str, key_parts: Iterable[object], compute: Callable[[], dict[str, np.ndarray]]
+) -> dict[str, np.ndarray]:
     """``compute()``, or what an earlier call with the same ``kind`` and ``key_parts`` stored."""
     directory = cache_dir()
     if directory is None:

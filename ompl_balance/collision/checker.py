@@ -70,8 +70,9 @@ class Environment:
     def add_sphere(self, name: str, radius: float, position=(0.0, 0.0, 0.0)) -> None:
         self.add(name, Shape.sphere(radius), position)
 
-    def add_cylinder(self, name: str, radius: float, length: float, position=(0.0, 0.0, 0.0),
-                     orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+    def add_cylinder(
+        self, name: str, radius: float, length: float, position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)
+    ) -> None:
         """A cylinder along its local z, ``length`` the full height, centred on ``position``."""
         self.add(name, Shape.cylinder(radius, length), position, orientation_xyzw)
 
@@ -116,8 +117,13 @@ class CollisionChecker:
         ``False`` checks every pair with FCL (through FCL's broad phase for the environment).
     """
 
-    def __init__(self, robot: RobotModel, environment: Environment | None = None,
-                 spheres_per_geometry: int = 8, prefilter: bool = True):
+    def __init__(
+        self,
+        robot: RobotModel,
+        environment: Environment | None = None,
+        spheres_per_geometry: int = 8,
+        prefilter: bool = True,
+    ):
         self.robot = robot
         self.environment = environment or Environment()
         self.prefilter = prefilter
@@ -192,8 +198,14 @@ class CollisionChecker:
                 outputs = self._screen_outputs(len(chunk))
                 maybe = self._screen(q[chunk], outputs)
                 poses, obstacle_hits, self_hits = outputs
-                hit = next((k for k in np.flatnonzero(maybe)
-                            if not self._free_exact(poses[k], obstacle_hits[k], self_hits[k])), -1)
+                hit = next(
+                    (
+                        k
+                        for k in np.flatnonzero(maybe)
+                        if not self._free_exact(poses[k], obstacle_hits[k], self_hits[k])
+                    ),
+                    -1,
+                )
             if hit >= 0:
                 return int(chunk[hit])
         return -1
@@ -209,9 +221,11 @@ class CollisionChecker:
     def _screen_outputs(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Arrays :func:`~ompl_balance.collision.screening.screen` fills for ``n`` configurations:
         body poses, obstacle-geometry hits and self-pair hits."""
-        return (np.empty((n, self.robot.body_count, 4, 4)),
-                np.empty((n, len(self._obstacles), len(self._links)), dtype=bool),
-                np.empty((n, len(self._pairs)), dtype=bool))
+        return (
+            np.empty((n, self.robot.body_count, 4, 4)),
+            np.empty((n, len(self._obstacles), len(self._links)), dtype=bool),
+            np.empty((n, len(self._pairs)), dtype=bool),
+        )
 
     def _screen(self, q: np.ndarray, outputs) -> np.ndarray:
         """Screen ``q`` (n, dof) into ``outputs`` (from :meth:`_screen_outputs`); True where FCL must decide."""

@@ -125,6 +125,7 @@ class Shape:
             raise ValueError(f"bounding_spheres needs count >= 1, got {count}")
         known = _SPHERES_OF.setdefault(self, {})  # robots share shapes across checkers; compute once
         if count not in known:
+
             def compute() -> dict[str, np.ndarray]:
                 centres, radii = self._covering_spheres(count)
                 return {"centres": centres, "radii": radii}
@@ -144,17 +145,18 @@ class Shape:
             # cut long triangles first (the pieces cover the same surface) so spheres can shrink
             whole = _TrianglePiece(np.asarray(self.mesh.triangles, dtype=float))
             vertices, faces = trimesh.remesh.subdivide_to_size(
-                self.mesh.vertices, self.mesh.faces, max_edge=whole.radius / count, max_iter=20)
+                self.mesh.vertices, self.mesh.faces, max_edge=whole.radius / count, max_iter=20
+            )
             pieces = [_TrianglePiece(np.asarray(vertices, dtype=float)[faces])]
         else:
-            pose, half = self.bounding_box()  # identity pose for box and cylinder
+            _pose, half = self.bounding_box()  # identity pose for box and cylinder
             pieces = [_BoxPiece(np.zeros(3), np.asarray(half, dtype=float))]
         while len(pieces) < count:
             widest = max(range(len(pieces)), key=lambda i: pieces[i].radius)
             halves = pieces[widest].split()
             if halves is None:  # a single triangle: nothing left to cut
                 break
-            pieces[widest:widest + 1] = halves
+            pieces[widest : widest + 1] = halves
         return np.array([p.centre for p in pieces]), np.array([p.radius for p in pieces])
 
 

@@ -20,9 +20,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from itertools import combinations
 from pathlib import Path
-from urllib.parse import unquote, urlparse
-
 from typing import NamedTuple
+from urllib.parse import unquote, urlparse
 
 import numpy as np
 import trimesh
@@ -95,8 +94,11 @@ def chain_poses(q, chain, poses):  # pragma: no cover (compiled)
         # body = parent @ local, each entry of the joint's local transform computed once
         for m in range(3):
             for col in range(3):
-                local = (chain.rotation_fixed[k, m, col] + sin * chain.rotation_sin[k, m, col]
-                         - cos * chain.rotation_cos[k, m, col])
+                local = (
+                    chain.rotation_fixed[k, m, col]
+                    + sin * chain.rotation_sin[k, m, col]
+                    - cos * chain.rotation_cos[k, m, col]
+                )
                 for row in range(3):
                     body[row, col] += parent[row, m] * local
             local = chain.translation[k, m] + value * chain.slide[k, m]
@@ -156,7 +158,9 @@ class RobotModel:
                     stack.append((j.child, body, origin))
                     continue
                 if j.type not in MOVING_JOINTS:
-                    raise ValueError(f"joint {j.name!r} has unsupported type {j.type!r} (supported: fixed, {', '.join(MOVING_JOINTS)})")
+                    raise ValueError(
+                        f"joint {j.name!r} has unsupported type {j.type!r} (supported: fixed, {', '.join(MOVING_JOINTS)})"
+                    )
                 driver, mult, shift = j.name, 1.0, 0.0
                 if j.mimic is not None:
                     driver = j.mimic.joint
@@ -165,9 +169,18 @@ class RobotModel:
                     if driver not in active_index:
                         raise ValueError(f"mimic joint {j.name!r} follows {driver!r}, which is not an active joint")
                 axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, dtype=float)
-                self._joints.append(_MovingJoint(
-                    j.name, "prismatic" if j.type == "prismatic" else "revolute", body, origin,
-                    axis / np.linalg.norm(axis), active_index[driver], mult, shift))
+                self._joints.append(
+                    _MovingJoint(
+                        j.name,
+                        "prismatic" if j.type == "prismatic" else "revolute",
+                        body,
+                        origin,
+                        axis / np.linalg.norm(axis),
+                        active_index[driver],
+                        mult,
+                        shift,
+                    )
+                )
                 body_parent.append(body)
                 stack.append((j.child, len(self._joints), np.eye(4)))
         joints = self._joints
@@ -238,8 +251,13 @@ class RobotModel:
         if not urdf_path.is_file():
             raise FileNotFoundError(f"URDF file not found: {urdf_path}")
         try:
-            urdf = yourdfpy.URDF.load(str(urdf_path), build_scene_graph=False, load_meshes=False,
-                                      build_collision_scene_graph=False, load_collision_meshes=False)
+            urdf = yourdfpy.URDF.load(
+                str(urdf_path),
+                build_scene_graph=False,
+                load_meshes=False,
+                build_collision_scene_graph=False,
+                load_collision_meshes=False,
+            )
         except Exception as error:  # yourdfpy raises many types for broken files
             raise ValueError(f"cannot parse URDF {urdf_path}: {error}") from error
         if urdf.robot is None or not urdf.robot.links:
@@ -253,10 +271,14 @@ class RobotModel:
         q = np.asarray(q, dtype=float)
         q2 = q.reshape(1, -1) if q.ndim == 1 else q
         if q2.ndim != 2 or q2.shape[1] != self.dof:
-            raise ValueError(f"configurations must have shape (n, {self.dof}) for joints {self.joint_names}, got {q.shape}")
+            raise ValueError(
+                f"configurations must have shape (n, {self.dof}) for joints {self.joint_names}, got {q.shape}"
+            )
         if not np.isfinite(q2).all():
             row, col = np.argwhere(~np.isfinite(q2))[0]
-            raise ValueError(f"configuration {row} has non-finite value {q2[row, col]} for joint {self.joint_names[col]!r}")
+            raise ValueError(
+                f"configuration {row} has non-finite value {q2[row, col]} for joint {self.joint_names[col]!r}"
+            )
         return q2
 
     def body_poses(self, q) -> np.ndarray:
@@ -294,7 +316,7 @@ class _MeshResolver:
 
     def candidates(self, filename: str) -> list[Path]:
         if filename.startswith("package://"):
-            package, _, rest = filename[len("package://"):].partition("/")
+            package, _, rest = filename[len("package://") :].partition("/")
             found = [self.package_map[package] / rest] if package in self.package_map else []
             for folder in (self.urdf_dir, *self.urdf_dir.parents):
                 found.append(folder / package / rest)
@@ -312,7 +334,8 @@ class _MeshResolver:
                 return path
         raise FileNotFoundError(
             f"link {link!r}: collision mesh {filename!r} not found (tried {', '.join(map(str, tried[:4]))}"
-            f"{', ...' if len(tried) > 4 else ''}); pass package_map={{'PACKAGE': '/path/to/package'}}")
+            f"{', ...' if len(tried) > 4 else ''}); pass package_map={{'PACKAGE': '/path/to/package'}}"
+        )
 
 
 def _link_shapes(link, resolve: _MeshResolver):
@@ -340,7 +363,9 @@ def _link_shapes(link, resolve: _MeshResolver):
                 mesh.apply_scale(geometry.mesh.scale)
             yield origin, Shape.from_mesh(mesh), str(path)
         else:
-            raise ValueError(f"link {link.name!r}: unsupported collision geometry (supported: box, sphere, cylinder, mesh)")
+            raise ValueError(
+                f"link {link.name!r}: unsupported collision geometry (supported: box, sphere, cylinder, mesh)"
+            )
 
 
 def _srdf_disabled_pairs(srdf_path: Path) -> set[frozenset[str]]:

@@ -33,8 +33,11 @@ def load_example_robot_data_panda() -> RobotModel:
     """
     share = example_robot_data_dir()
     description = share / "robots" / "panda_description"
-    return RobotModel.from_urdf(description / "urdf" / "panda.urdf", description / "srdf" / "panda.srdf",
-                                package_map={"example-robot-data": str(share)})
+    return RobotModel.from_urdf(
+        description / "urdf" / "panda.urdf",
+        description / "srdf" / "panda.srdf",
+        package_map={"example-robot-data": str(share)},
+    )
 
 
 #: VAMP's Panda as shipped with the package (URDF, SRDF, collision meshes; Apache-2.0).

@@ -98,7 +98,8 @@ def build_volumes(robot, obstacles, spheres_per_geometry: int) -> Volumes:
         outer_radius=np.array([r[0] for _, r in outer], dtype=float),
         sphere_start=np.concatenate([[0], np.cumsum([len(r) for _, r in small])]).astype(np.int64),
         sphere_centre=np.concatenate([in_body(g, c) for g, (c, _) in zip(geometries, small)]).reshape(-1, 3)
-        if geometries else np.zeros((0, 3)),
+        if geometries
+        else np.zeros((0, 3)),
         sphere_radius=np.concatenate([r for _, r in small]) if geometries else np.zeros(0),
         box_centre=np.array([c for c, _, _ in boxes], dtype=float).reshape(-1, 3),
         box_axes=np.array([a for _, a, _ in boxes], dtype=float).reshape(-1, 3, 3),
@@ -116,7 +117,7 @@ def two_joint_path(chain, body_a: int, body_b: int) -> tuple[int, int] | None:
     """The two revolute joints ``(upper, lower)`` between ``body_a`` and its descendant
     ``body_b``, or ``None`` when ``body_b`` is not a descendant or other joints lie between."""
     path, body = [], body_b
-    while body != body_a and body != 0:
+    while body not in (body_a, 0):
         path.append(body - 1)  # joint k moves body k + 1
         body = chain.parent_body[body - 1]
     if body != body_a or len(path) != 2 or chain.slide[path].any():
@@ -166,8 +167,9 @@ def free_table(robot, a: int, b: int, upper: int, lower: int) -> tuple[np.ndarra
     ends += chain.shift[joints, None]
     low, high = ends.min(axis=1), ends.max(axis=1)
 
-    by_value = chain._replace(source=np.arange(len(chain.source)), multiplier=np.ones(len(chain.source)),
-                              shift=np.zeros(len(chain.source)))  # chain_poses of joint values
+    by_value = chain._replace(
+        source=np.arange(len(chain.source)), multiplier=np.ones(len(chain.source)), shift=np.zeros(len(chain.source))
+    )  # chain_poses of joint values
     objects = [fcl.CollisionObject(g.shape.fcl_geometry(), fcl.Transform()) for g in (geometry_a, geometry_b)]
     values, poses = np.zeros(len(chain.source)), np.empty((robot.body_count, 4, 4))
 
@@ -188,7 +190,7 @@ def free_table(robot, a: int, b: int, upper: int, lower: int) -> tuple[np.ndarra
         gap = distance(low + (np.array([i, j]) + 0.5) * width)
         if gap > float(rho @ (0.5 * width)) + SLACK:
             span = 1 << (TABLE_LEVELS - level)
-            free[i * span:(i + 1) * span, j * span:(j + 1) * span] = True
+            free[i * span : (i + 1) * span, j * span : (j + 1) * span] = True
         elif gap > 0.0 and level < TABLE_LEVELS:
             pending += [(level + 1, 2 * i + di, 2 * j + dj) for di in (0, 1) for dj in (0, 1)]
     return low, (high - low) / finest, free
@@ -204,8 +206,15 @@ def _free_tables(robot) -> dict[str, np.ndarray]:
     the disk cache (:mod:`ompl_balance.collision.cache`) under everything they are computed from.
     """
     if robot not in _TABLES_OF:
-        key = [*robot.chain, robot.lower, robot.upper, np.array(robot.self_collision_pairs),
-               TABLE_COARSE_CELLS, TABLE_LEVELS, SLACK]
+        key = [
+            *robot.chain,
+            robot.lower,
+            robot.upper,
+            np.array(robot.self_collision_pairs),
+            TABLE_COARSE_CELLS,
+            TABLE_LEVELS,
+            SLACK,
+        ]
         for g in robot.geometries:
             mesh = () if g.shape.mesh is None else (np.asarray(g.shape.mesh.vertices), np.asarray(g.shape.mesh.faces))
             key += [g.body, g.origin, g.shape.kind, g.shape.dims, *mesh]
@@ -233,15 +242,15 @@ def _compute_free_tables(robot) -> dict[str, np.ndarray]:
         starts.append(start)
         grids.append(free.ravel())
         start += free.size
-    return dict(
-        pair_table=np.array(pair_table, dtype=np.int64),
-        table_joints=np.array(joints, dtype=np.int64).reshape(-1, 2),
-        table_low=np.array(lows, dtype=float).reshape(-1, 2),
-        table_cell=np.array(cells, dtype=float).reshape(-1, 2),
-        table_cells=np.array(counts, dtype=np.int64).reshape(-1, 2),
-        table_start=np.array(starts, dtype=np.int64),
-        table_free=np.concatenate(grids) if grids else np.zeros(0, dtype=bool),
-    )
+    return {
+        "pair_table": np.array(pair_table, dtype=np.int64),
+        "table_joints": np.array(joints, dtype=np.int64).reshape(-1, 2),
+        "table_low": np.array(lows, dtype=float).reshape(-1, 2),
+        "table_cell": np.array(cells, dtype=float).reshape(-1, 2),
+        "table_cells": np.array(counts, dtype=np.int64).reshape(-1, 2),
+        "table_start": np.array(starts, dtype=np.int64),
+        "table_free": np.concatenate(grids) if grids else np.zeros(0, dtype=bool),
+    }
 
 
 @njit(cache=True)
@@ -341,11 +350,37 @@ def warm_up() -> None:
     spent here instead of in a robot's first check. The benchmark runner's forkserver
     does this once (:mod:`ompl_balance.collision.warm_kernels`), so run processes start warm."""
     integers, reals = (lambda *shape: np.zeros(shape, dtype=np.int64)), (lambda *shape: np.zeros(shape))
-    chain = Chain(integers(1), reals(1), reals(1), integers(1), reals(1, 3, 3), reals(1, 3, 3), reals(1, 3, 3),
-                  reals(1, 3), reals(1, 3), reals(1, 3))
-    volumes = Volumes(integers(0), reals(0, 3), reals(0), integers(1), reals(0, 3), reals(0), reals(0, 3),
-                      reals(0, 3, 3), reals(0, 3), integers(0, 2), integers(0), integers(0, 2), reals(0, 2),
-                      reals(0, 2), integers(0, 2), integers(0), np.zeros(0, dtype=bool))
+    chain = Chain(
+        integers(1),
+        reals(1),
+        reals(1),
+        integers(1),
+        reals(1, 3, 3),
+        reals(1, 3, 3),
+        reals(1, 3, 3),
+        reals(1, 3),
+        reals(1, 3),
+        reals(1, 3),
+    )
+    volumes = Volumes(
+        integers(0),
+        reals(0, 3),
+        reals(0),
+        integers(1),
+        reals(0, 3),
+        reals(0),
+        reals(0, 3),
+        reals(0, 3, 3),
+        reals(0, 3),
+        integers(0, 2),
+        integers(0),
+        integers(0, 2),
+        reals(0, 2),
+        reals(0, 2),
+        integers(0, 2),
+        integers(0),
+        np.zeros(0, dtype=bool),
+    )
     q, poses = reals(1, 1), reals(1, 2, 4, 4)
     screen(q, chain, volumes, poses, np.zeros((1, 0, 0), dtype=bool), np.zeros((1, 0), dtype=bool))
     _chain_poses_batch(q, chain, poses)

@@ -230,8 +230,11 @@ def add_accessors(cls: type, settings: type[Settings], attribute: str = "setting
             if name in cls.__dict__:
                 continue
             method.__name__ = method.__qualname__ = name
-            method.__doc__ = (f"The ``{row.name}`` parameter: {row.doc}" if verb == "get" else
-                              f"Set the ``{row.name}`` parameter ({row.domain.describe()}): {row.doc}")
+            method.__doc__ = (
+                f"The ``{row.name}`` parameter: {row.doc}"
+                if verb == "get"
+                else f"Set the ``{row.name}`` parameter ({row.domain.describe()}): {row.doc}"
+            )
             setattr(cls, name, method)
 
 

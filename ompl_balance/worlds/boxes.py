@@ -39,10 +39,7 @@ class BoxWorld2D:
         """``True`` when the point ``(x, y)`` lies in no box (``False`` for NaN or infinite)."""
         if not (math.isfinite(x) and math.isfinite(y)):
             return False
-        for x_min, y_min, x_max, y_max in self.boxes:
-            if x_min <= x <= x_max and y_min <= y <= y_max:
-                return False
-        return True
+        return all(not (x_min <= x <= x_max and y_min <= y <= y_max) for x_min, y_min, x_max, y_max in self.boxes)
 
     def __call__(self, state: ob.State) -> bool:
         return self.is_free(state[0], state[1])
@@ -127,4 +124,3 @@ def get_problem(name: str) -> Problem:
     if name not in PROBLEMS:
         raise KeyError(f"unknown problem {name!r}; built-in problems: {', '.join(PROBLEMS)}")
     return PROBLEMS[name]
-

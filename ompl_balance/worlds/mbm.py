@@ -24,7 +24,6 @@ from ..collision.checker import CollisionChecker, Environment
 from ..collision.kinematics import RobotModel
 from ..validity import setup_robot, space_for
 
-
 #: The scenarios shipped with the package (``data/mbm/panda/<name>.json``).
 SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small")
 MBM_DIR = Path(str(resources.files("ompl_balance") / "data" / "mbm" / "panda"))
@@ -36,8 +35,9 @@ def scenario_path(scenario: str | Path) -> Path:
         return MBM_DIR / f"{scenario}.json"
     path = Path(scenario)
     if not path.is_file():
-        raise ValueError(f"{str(scenario)!r} is neither a shipped MotionBenchMaker scenario "
-                         f"({', '.join(SCENARIOS)}) nor a file")
+        raise ValueError(
+            f"{str(scenario)!r} is neither a shipped MotionBenchMaker scenario ({', '.join(SCENARIOS)}) nor a file"
+        )
     return path
 
 
@@ -89,11 +89,15 @@ def load_mbm(scenario: str | Path, joint_names: list[str] | None = None) -> list
     joint_names = list(file_joints) if joint_names is None else list(joint_names)
     unknown = sorted(set(file_joints) ^ set(joint_names))
     if unknown:
-        raise ValueError(f"{path}: joint names {unknown} are not in both the file {file_joints} and the robot {joint_names}")
+        raise ValueError(
+            f"{path}: joint names {unknown} are not in both the file {file_joints} and the robot {joint_names}"
+        )
     column = [file_joints.index(name) for name in joint_names]
     scenario = str(data.get("scenario", path.stem))
-    return [_problem(p, scenario, column, f"{path} problem {p.get('id', i) if isinstance(p, dict) else i}")
-            for i, p in enumerate(_field(data, "problems", path))]
+    return [
+        _problem(p, scenario, column, f"{path} problem {p.get('id', i) if isinstance(p, dict) else i}")
+        for i, p in enumerate(_field(data, "problems", path))
+    ]
 
 
 def _field(record, name: str, where):
@@ -129,5 +133,6 @@ def _problem(record, scenario: str, column: list[int], where: str) -> MBMProblem
                 raise ValueError(f"unknown obstacle type {kind!r} (box, cylinder, sphere)")
         except (TypeError, ValueError) as error:
             raise ValueError(f"{at}: {error}") from error
-    return MBMProblem(scenario, int(_field(record, "id", where)), start, goals, environment,
-                      bool(record.get("valid", True)))
+    return MBMProblem(
+        scenario, int(_field(record, "id", where)), start, goals, environment, bool(record.get("valid", True))
+    )

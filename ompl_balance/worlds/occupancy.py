@@ -21,7 +21,6 @@ from ompl import base as ob
 from ompl import geometric as og
 
 
-
 @dataclass(frozen=True, eq=False)
 class OccupancyGrid:
     """A 2-D occupancy grid: ``occupied`` ``(rows, cols)`` bool, square cells of side ``resolution`` (m)."""
@@ -33,7 +32,9 @@ class OccupancyGrid:
     def __post_init__(self) -> None:
         occupied = np.asarray(self.occupied)
         if occupied.ndim != 2 or occupied.dtype != bool or occupied.size == 0:
-            raise ValueError(f"occupied must be a non-empty 2-D boolean array, got shape {occupied.shape} dtype {occupied.dtype}")
+            raise ValueError(
+                f"occupied must be a non-empty 2-D boolean array, got shape {occupied.shape} dtype {occupied.dtype}"
+            )
         if not math.isfinite(self.resolution) or self.resolution <= 0:
             raise ValueError(f"resolution must be a positive cell side in metres, got {self.resolution!r}")
         object.__setattr__(self, "occupied", occupied)
@@ -101,7 +102,9 @@ class GridValidityChecker(ob.StateValidityChecker):
         elif isinstance(space, ob.RealVectorStateSpace) and space.getDimension() >= 2:
             self._position = lambda state: (state[0], state[1])
         else:
-            raise TypeError(f"a grid checker needs an SE2 or a real-vector space of dimension >= 2, got {type(space).__name__}")
+            raise TypeError(
+                f"a grid checker needs an SE2 or a real-vector space of dimension >= 2, got {type(space).__name__}"
+            )
         self.grid = grid
         self.states_checked = 0
 
@@ -126,7 +129,9 @@ def rooms_grid(side: float = 40.0, resolution: float = 0.2) -> OccupancyGrid:
     """
     cells = round(side / resolution)
     if cells < 50:
-        raise ValueError(f"the floor plan needs at least 50 cells a side, got side {side} m / resolution {resolution} m")
+        raise ValueError(
+            f"the floor plan needs at least 50 cells a side, got side {side} m / resolution {resolution} m"
+        )
     occupied = np.zeros((cells, cells), dtype=bool)
     unit = side / 10
 
