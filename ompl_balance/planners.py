@@ -25,6 +25,7 @@ compared (``SwapLimitRRTConnect``, ...); ``docs/variants.md`` measures them.
 from __future__ import annotations
 
 import enum
+import itertools
 import sys
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -135,6 +136,7 @@ class RunStats:
         valid-state sampler checked.
     motions_checked: motions handed to the motion validator during this solve.
     time: wall-clock seconds spent in ``solve()``.
+    distance_queries: exact distance queries a certified motion validator made (0 for others).
     swaps_alternate, swaps_balance, swaps_steps, swaps_collision: ``tree_swaps`` by
         :class:`~ompl_balance.policies.SwapCause`.
     sampler_rejections: samples the sample policy drew and discarded (outside the
@@ -152,6 +154,7 @@ class RunStats:
     states_checked: int
     motions_checked: int
     time: float
+    distance_queries: int = 0
     swaps_alternate: int = 0
     swaps_balance: int = 0
     swaps_steps: int = 0
@@ -363,7 +366,7 @@ class BalancedRRTConnect(TreePlanner):
         sample = target_sampler(settings.sample_policy, self._sample_context(points, rng, counts, find_nearest))
 
         status = ob.PlannerStatus.TIMEOUT
-        iterations = 0
+        progress = self.progress
         grew_start, steps, collided = self._loop_state
         while not ptc():
             # Goal states join the goal tree while fewer than half of its states were sampled.
@@ -375,12 +378,12 @@ class BalancedRRTConnect(TreePlanner):
                     ou.OMPL_ERROR(f"{name}: Unable to sample any valid states for goal tree")
                     status = ob.PlannerStatus.INVALID_GOAL
                     break
-            iterations += 1
+            progress.iterations += 1
 
             grow_start, cause = choose_tree(grew_start, len(start_tree), len(goal_tree), steps, collided)
             if grow_start != grew_start:
                 steps, collided = 0, False
-                if iterations > 1:
+                if progress.iterations > 1:
                     swaps[cause] += 1
             grew_start = grow_start
             tree, other_tree = (start_tree, goal_tree) if grow_start else (goal_tree, start_tree)
@@ -407,7 +410,9 @@ class BalancedRRTConnect(TreePlanner):
             start_root = points.ompl_state(start_tree.state(start_tree.root(start_node)), 0)
             goal_root = points.ompl_state(goal_tree.state(goal_tree.root(goal_node)), 1)
             if goal.isStartGoalPairValid(start_root, goal_root):
-                self._add_solution(points, self._path_points(start_node, goal_node))
+                path = self._path_points(start_node, goal_node)
+                self._add_solution(points, path)
+                progress.best_cost = sum(points.distance(a, b) for a, b in itertools.pairwise(path))
                 status = ob.PlannerStatus.EXACT_SOLUTION
                 break
 
@@ -416,7 +421,13 @@ class BalancedRRTConnect(TreePlanner):
             f"{name}: Created {len(start_tree) + len(goal_tree)} states "
             f"({len(start_tree)} start + {len(goal_tree)} goal)"
         )
-        return result(status, iterations)
+        return result(status, progress.iterations)
+
+    def _progress_extras(self) -> dict[str, Callable[[], str]]:
+        return {
+            "start tree size INTEGER": lambda: str(len(self._start_tree or ())),
+            "goal tree size INTEGER": lambda: str(len(self._goal_tree or ())),
+        }
 
     def _sample_context(
         self, points: Points, rng: np.random.Generator, counts: SamplerCounts, find_nearest: NearestFinder | None

@@ -10,6 +10,7 @@ radius mode, delayed collision checking).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -80,7 +81,7 @@ class RRTstarStats:
         path, ``None`` if none was found or a path existed before this solve.
     ball_radius_constant: the ``gamma`` used (estimated at setup in ``auto`` mode).
     rewires: tree nodes given a cheaper parent through a new node.
-    states_checked, motions_checked: as in :class:`~ompl_balance.planners.RunStats`.
+    states_checked, motions_checked, distance_queries: as in :class:`~ompl_balance.planners.RunStats`.
     time: wall-clock seconds spent in ``solve()``.
     best_costs: ``(iterations,)`` best cost after each iteration, ``inf`` before the
         first path; never increases.
@@ -97,6 +98,7 @@ class RRTstarStats:
     motions_checked: int
     time: float
     best_costs: np.ndarray = field(repr=False)
+    distance_queries: int = 0
 
     def as_dict(self) -> dict[str, float | int | str | None]:
         """The scalar fields (``best_costs`` left out)."""
@@ -245,9 +247,12 @@ class BallRadiusRRTstar(TreePlanner):
         tree = nodes.tree
         best_before = nodes.best_cost()
         improvements: list[tuple[int, float]] = []  # (iteration, new best cost)
-        iterations = rewires = 0
+        progress = self.progress
+        progress.best_cost = best_before
+        rewires = 0
 
         def result(status: ob.PlannerStatus.PlannerStatusType) -> tuple[Any, dict[str, Any]]:
+            iterations = progress.iterations
             best_costs = np.full(iterations, best_before)
             for iteration, cost in improvements:
                 best_costs[iteration - 1 :] = cost
@@ -281,8 +286,8 @@ class BallRadiusRRTstar(TreePlanner):
         d, eta = si.getStateDimension(), settings.max_connection_distance
         max_iterations, max_nodes = settings.max_iterations or math.inf, settings.max_nodes or math.inf
         best = nodes.best_cost()
-        while not ptc() and iterations < max_iterations and len(tree) < max_nodes:
-            iterations += 1
+        while not ptc() and progress.iterations < max_iterations and len(tree) < max_nodes:
+            progress.iterations += 1
             if (
                 sampleable is not None
                 and len(nodes.goal_nodes) < sampleable.maxSampleCount()
@@ -340,8 +345,8 @@ class BallRadiusRRTstar(TreePlanner):
             if (found_goal or rewired) and nodes.goal_nodes:
                 candidate = nodes.best_cost()
                 if candidate < best:
-                    best = candidate
-                    improvements.append((iterations, best))
+                    best = progress.best_cost = candidate
+                    improvements.append((progress.iterations, best))
                     if not settings.continue_after_goal_reached or objective.isSatisfied(ob.Cost(best)):
                         break
 
@@ -352,6 +357,9 @@ class BallRadiusRRTstar(TreePlanner):
             status = ob.PlannerStatus.TIMEOUT
         ou.OMPL_INFORM(f"{name}: Created {len(tree)} states, {rewires} rewires; best cost {best:.4g}")
         return result(status)
+
+    def _progress_extras(self) -> dict[str, Callable[[], str]]:
+        return {"tree size INTEGER": lambda: str(len(self._tree or ()))}
 
     def _fill_planner_data(self, data: ob.PlannerData, points: Points, keep_alive: list[ob.State]) -> None:
         """The tree, tag 1: roots are start vertices, goal nodes goal vertices; edges parent -> child."""

@@ -7,7 +7,12 @@ Every checker of this package exposes ``counters()`` returning a dict with at le
     states whose validity was decided (each call of ``isValid``, and each state a
     batched motion validator looked at),
 ``motions_checked``
-    motions (edges) handed to a motion validator.
+    motions (edges) handed to a motion validator;
+
+and may have
+
+``distance_queries``
+    exact distance queries a certified motion validator made (0 when absent).
 
 A plain Python callable given to ``si.setStateValidityChecker`` counts nothing, so
 :func:`ensure_counting` wraps whatever checker the space information has in a
@@ -56,13 +61,18 @@ class CountingValidityChecker(ob.StateValidityChecker):
 
 @dataclass(frozen=True)
 class WorkCount:
-    """States and motions checked, read from a space information's checkers."""
+    """States and motions checked, and distance queries made, read from a space information's checkers."""
 
     states_checked: int
     motions_checked: int
+    distance_queries: int = 0
 
     def __sub__(self, other: WorkCount) -> WorkCount:
-        return WorkCount(self.states_checked - other.states_checked, self.motions_checked - other.motions_checked)
+        return WorkCount(
+            self.states_checked - other.states_checked,
+            self.motions_checked - other.motions_checked,
+            self.distance_queries - other.distance_queries,
+        )
 
 
 def ensure_counting(si: ob.SpaceInformation) -> None:
@@ -90,15 +100,16 @@ def read_work(si: ob.SpaceInformation) -> WorkCount:
     OMPL's own motion counter.
     """
     checker = si.getStateValidityChecker()
-    states = checker.counters()["states_checked"] if hasattr(checker, "counters") else 0
+    counters = checker.counters() if hasattr(checker, "counters") else {}
     validator = si.getMotionValidator()
     if validator is None:
         motions = 0
     elif hasattr(validator, "counters"):
-        motions = validator.counters()["motions_checked"]
+        counters = {**counters, **validator.counters()}
+        motions = counters["motions_checked"]
     else:
         motions = validator.getCheckedMotionCount()
-    return WorkCount(states, motions)
+    return WorkCount(counters.get("states_checked", 0), motions, counters.get("distance_queries", 0))
 
 
 @dataclass(frozen=True)

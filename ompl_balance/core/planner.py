@@ -11,7 +11,8 @@ the rest the same way for all of them:
 * ``solve(ptc)``: the termination condition from what it was given (a condition, seconds
   or a callable), the seed of the solve (the ``seed`` parameter, or a draw from the planner's
   OMPL ``RNG``, which ``ompl.util.RNG.setSeed`` repeats), the work counted, and ``stats``;
-* the solution path added to the problem definition, and the trees as ``ob.PlannerData``.
+* the solution path added to the problem definition, and the trees as ``ob.PlannerData``;
+* progress properties (:meth:`TreePlanner.progressProperties`), readable while a solve runs.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
@@ -63,13 +65,21 @@ def termination_condition(limit: Limit) -> ob.PlannerTerminationCondition:
     )
 
 
+@dataclass
+class Progress:
+    """What a solve has done so far, updated as it runs (read by :meth:`TreePlanner.progressProperties`)."""
+
+    iterations: int = 0
+    best_cost: float = math.inf  # cost (path length) of the best solution so far
+
+
 class TreePlanner(ob.Planner):
     """Base of the package's planners (see the module docstring).
 
     Subclasses set ``Settings`` (their parameter table, which must have ``seed``) and
-    ``Stats`` (a dataclass with ``status``, ``states_checked``, ``motions_checked`` and
-    ``time`` fields besides those :meth:`_plan` returns), and implement :meth:`_plan`
-    and :meth:`_fill_planner_data`.
+    ``Stats`` (a dataclass with ``status``, ``states_checked``, ``motions_checked``,
+    ``distance_queries`` and ``time`` fields besides those :meth:`_plan` returns), implement
+    :meth:`_plan` (keeping :attr:`progress` current) and :meth:`_fill_planner_data`.
     """
 
     Settings: ClassVar[type[Settings]]
@@ -86,6 +96,7 @@ class TreePlanner(ob.Planner):
         self._params = ParamSet.of(self.settings)
         self._rng = ou.RNG()  # per-planner stream, seeded from OMPL's global seed
         self._points: Points | None = None  # how the last solve saw the space
+        self.progress = Progress()
         self.stats: Any = None
 
     def params(self) -> ParamSet:
@@ -112,16 +123,37 @@ class TreePlanner(ob.Planner):
         work_before = read_work(si)
         rng = np.random.default_rng(self.settings.seed or self._draw_seed())
         self._points = points_for(si, rng)
+        self.progress = Progress()
         status, fields = self._plan(ptc, self._points, rng)
         work = read_work(si) - work_before
         self.stats = self.Stats(
             status=ob.PlannerStatus(status).asString(),
             states_checked=work.states_checked,
             motions_checked=work.motions_checked,
+            distance_queries=work.distance_queries,
             time=time.perf_counter() - began,
             **fields,
         )
         return ob.PlannerStatus(status)
+
+    def progressProperties(self) -> dict[str, Callable[[], str]]:  # noqa: N802 (OMPL's style)
+        """OMPL's planner progress properties: ``"name TYPE"`` -> a function giving the current
+        value as a string, safe to call from another thread while a solve runs (as
+        ``ompl.tools.Benchmark`` samples ``getPlannerProgressProperties()``; OMPL 2.0's bindings
+        cannot return that map, hence this method).
+
+        ``iterations INTEGER`` and ``best cost REAL`` (``inf`` until a path is found) for every
+        planner, plus what :meth:`_progress_extras` adds.
+        """
+        return {
+            "iterations INTEGER": lambda: str(self.progress.iterations),
+            "best cost REAL": lambda: repr(float(self.progress.best_cost)),
+            **self._progress_extras(),
+        }
+
+    def _progress_extras(self) -> dict[str, Callable[[], str]]:
+        """Further progress properties of a subclass (override)."""
+        return {}
 
     def _draw_seed(self) -> int:
         """A seed from the planner's OMPL ``RNG`` (repeated by ``ompl.util.RNG.setSeed``)."""
