@@ -15,6 +15,7 @@ import json
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from ompl import base as ob
@@ -55,7 +56,18 @@ class MBMProblem:
     def simple_setup(self, robot: RobotModel, checker: CollisionChecker | None = None) -> og.SimpleSetup:
         """A ``SimpleSetup`` for this problem: ``robot``'s joint space, the package's checker
         and motion validator (``checker``, or a new one for this environment), the start,
-        and every goal as ``ob.GoalStates`` (any goal is a success)."""
+        and every goal as ``ob.GoalStates`` (any goal is a success).
+
+        ``ValueError`` when ``robot`` has another number of joints than the problem's
+        configurations (load the problems with ``load_mbm(scenario, robot.joint_names)``:
+        it reorders them to the robot's joints and refuses joints the two do not share).
+        """
+        if robot.dof != len(self.start):
+            raise ValueError(
+                f"MotionBenchMaker {self.scenario} problem {self.id}: its configurations have {len(self.start)} joint "
+                f"values but robot {robot.name!r} has {robot.dof} joints ({', '.join(robot.joint_names)}); load the "
+                "problems with load_mbm(scenario, robot.joint_names) for the robot they were made for"
+            )
         ss = og.SimpleSetup(space_for(robot))
         setup_robot(ss, checker or CollisionChecker(robot, self.environment))
         si = ss.getSpaceInformation()
@@ -100,20 +112,20 @@ def load_mbm(scenario: str | Path, joint_names: list[str] | None = None) -> list
     ]
 
 
-def _field(record, name: str, where):
+def _field(record: Any, name: str, where: object) -> Any:
     if not isinstance(record, dict) or name not in record:
         raise ValueError(f"{where}: missing field {name!r}")
     return record[name]
 
 
-def _configurations(values, width: int, where: str) -> np.ndarray:
+def _configurations(values: Any, width: int, where: str) -> np.ndarray:
     array = np.asarray(values, dtype=float)
     if array.ndim != 2 or array.shape[1] != width or not np.all(np.isfinite(array)):
         raise ValueError(f"{where}: expected finite configurations of {width} joint values, got {values!r}")
     return array
 
 
-def _problem(record, scenario: str, column: list[int], where: str) -> MBMProblem:
+def _problem(record: Any, scenario: str, column: list[int], where: str) -> MBMProblem:
     start = _configurations([_field(record, "start", where)], len(column), f"{where} start")[0, column]
     goals = _configurations(_field(record, "goals", where), len(column), f"{where} goals")[:, column]
     environment = Environment()
