@@ -126,6 +126,10 @@ def _import_function(reference: str) -> Callable:
     return function
 
 
+#: Planners built to try parameters, never destroyed: some crash when destroyed (OMPL 2.0.1's AORRTC).
+_TRIED_PLANNERS: list[ob.Planner] = []
+
+
 @dataclass(frozen=True)
 class PlannerSpec:
     """A planner of the experiment.
@@ -167,11 +171,14 @@ class PlannerSpec:
             raise ExperimentError(
                 "name", f"unknown planner {self.name!r}; known: {', '.join(sorted(known))}", self.name
             )
+        if not self.params:
+            return
         space = ob.RealVectorStateSpace(2)
         space.setBounds(0.0, 1.0)
         si = ob.SpaceInformation(space)
         si.setStateValidityChecker(lambda state: True)
         planner = known[self.name](si)
+        _TRIED_PLANNERS.append(planner)
         for name, value in self.params.items():
             try:
                 set_planner_param(planner, name, value)

@@ -97,7 +97,12 @@ class MemoryLimit:
     """OMPL's memory limit: ends the solve through its termination condition once the process's
     peak resident memory has grown by ``limit`` MB since the ``with`` block began (checked
     every 0.05 s, as ``Benchmark``'s condition checks ``getProcessMemoryUsage``); the planner
-    then returns what it has, as under a time limit. ``limit <= 0``: no limit."""
+    then returns what it has, as under a time limit. ``limit <= 0``: no limit.
+
+    Behind it, for a planner that ignores its termination condition, the process's address
+    space may grow by at most 2 x ``limit`` + :data:`ADDRESS_SPACE_MARGIN` MB (Linux only):
+    past that an allocation fails and the run is recorded as ``CRASH``.
+    """
 
     def __init__(self, limit: float, ptc: ob.PlannerTerminationCondition) -> None:
         self.limit, self.ptc, self.reached = limit, ptc, False
@@ -109,6 +114,7 @@ class MemoryLimit:
         self.start = _peak_memory()
         if self.limit > 0:
             self._thread.start()
+            _limit_address_space(2 * self.limit + ADDRESS_SPACE_MARGIN)
         return self
 
     def __exit__(self, *exc_info: object) -> None:
@@ -122,6 +128,12 @@ class MemoryLimit:
                 self.reached = True
                 self.ptc.terminate()
                 return
+
+
+#: The run's OMPL objects, never destroyed: the process ends with ``os._exit`` after sending its
+#: record, and some planners crash when destroyed (OMPL 2.0.1's ``AORRTC``), which must not
+#: cost the run its record.
+_KEEP_UNTIL_EXIT: list[og.SimpleSetup] = []
 
 
 def execute(task: RunTask) -> Record:
@@ -149,6 +161,7 @@ def execute(task: RunTask) -> Record:
     if run_seeded:
         planner.setSeed(task.seed)
     ss.setPlanner(planner)
+    _KEEP_UNTIL_EXIT.append(ss)
     ss.setup()  # not timed: setup wraps the checker to count, loads compiled scans, ...
     params = planner_params(planner)
     if run_seeded:
@@ -164,7 +177,7 @@ def execute(task: RunTask) -> Record:
         work = read_work(si) - work_before
         crashed = failure_properties("CRASH", time.perf_counter() - began)
         crashed.update(_work_properties(work.states_checked, work.motions_checked, work.distance_queries))
-        return _record(task, "CRASH", crashed, params, traceback.format_exc(limit=-3), sampler)
+        return _named(_record(task, "CRASH", crashed, params, traceback.format_exc(limit=-3), sampler), planner)
     elapsed = time.perf_counter() - began
     work = read_work(si) - work_before
     status_name = _status_name(status)
@@ -203,8 +216,13 @@ def execute(task: RunTask) -> Record:
     record = _record(task, status_name, properties, params, "", sampler)
     if memory.reached:
         record["note"] = f"stopped at the memory limit of {task.memory_limit:g} MB"
+    return _named(record, planner)
+
+
+def _named(record: Record, planner: ob.Planner) -> Record:
+    """``record``, marked when its parameters are named after getters, not OMPL's declared names."""
     if named_by_getters(planner):
-        record["param_names"] = "getters"  # not OMPL's declared names (see planner_params)
+        record["param_names"] = "getters"
     return record
 
 
@@ -260,8 +278,6 @@ def _record(
 def _child(task: RunTask, connection: Any) -> None:
     """Entry point of a run's process: limits, run, send the record (or the traceback)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C stops the sweep, which ends its runs
-    if task.memory_limit > 0:
-        _limit_address_space(task.memory_limit)
     ou.setLogLevel(ou.LOG_ERROR)
     try:
         connection.send(execute(task))
@@ -269,15 +285,17 @@ def _child(task: RunTask, connection: Any) -> None:
         connection.send(_record(task, "CRASH", failure_properties("CRASH", 0.0), error=traceback.format_exc(limit=-3)))
 
 
-def _limit_address_space(memory_limit: float) -> None:
-    """The backstop behind :class:`MemoryLimit`: the address space may grow by at most 2 x the
-    limit (a planner that ignores its termination condition then fails to allocate and the run
-    is recorded as ``CRASH``). Linux only (elsewhere the soft limit alone applies)."""
+#: MB of address space allowed besides 2 x the memory limit (threads reserve malloc arenas of 64 MB).
+ADDRESS_SPACE_MARGIN = 256.0
+
+
+def _limit_address_space(growth: float) -> None:
+    """Let this process's address space grow by at most ``growth`` MB from now (Linux only)."""
     try:
         pages = int(Path("/proc/self/statm").read_text().split()[0])
     except (OSError, ValueError, IndexError):
         return
-    limit = pages * os.sysconf("SC_PAGE_SIZE") + int(2 * memory_limit * 2**20)
+    limit = pages * os.sysconf("SC_PAGE_SIZE") + int(growth * 2**20)
     resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
 
