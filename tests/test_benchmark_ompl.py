@@ -267,3 +267,29 @@ def test_a_run_reaching_its_memory_limit_stops_as_ompl_stops_it(tmp_path):
     assert "memory limit of 60 MB" in record["note"]
     assert record["properties"]["time REAL"] < 10.0
     assert 60.0 < record["properties"]["memory REAL"] < 60.0 + 100.0
+
+
+def test_plot_draws_median_best_cost_against_time(arena):
+    pytest.importorskip("matplotlib")
+    from ompl_balance.bench.plots import plot_folder
+
+    out, _records = arena
+    written = {path.name for path in plot_folder(out, tree_iterations=20)}
+    assert {"progress_narrow_gap.png", "success_vs_time.png", "narrow_gap.png", "trees_narrow_gap.png"} <= written
+
+
+def test_median_best_cost_holds_each_runs_last_sample():
+    from ompl_balance.bench.plots import median_best_cost
+
+    def run(samples):
+        return {"progress": {"properties": ["best cost REAL", "time REAL"], "samples": samples}}
+
+    runs = [
+        run([["inf", "0.05"], ["3", "0.10"], ["2", "0.15"]]),
+        run([["5", "0.05"], ["4", "0.10"]]),
+        run([["inf", "0.05"], ["inf", "0.10"], ["1", "0.15"]]),
+    ]
+    grid = [0.0, 0.05, 0.1, 0.12, 0.15, 0.3]
+    # per time: the three runs' values (inf before a sample or a path), then their median
+    expected = [math.inf, math.inf, 4.0, 4.0, 2.0, 2.0]
+    assert list(median_best_cost(runs, grid)) == expected

@@ -261,8 +261,12 @@ def plot_trees(problem: str, iterations: int, path: Path, seed: int = 1) -> Path
         axis.set_xlim(0, 1)
         axis.set_ylim(0, 1)
         axis.set_aspect("equal")
-        axis.set_title(f"{'balanced' if balance else 'alternating'} growth, {done} iterations", fontsize=10)
-        axis.legend(loc="lower right", fontsize=8)
+        ending = "solved after" if done < iterations else "stopped after"
+        axis.set_title(
+            f"{'balanced' if balance else 'alternating'} growth, {ending} {done} iteration{'s' * (done != 1)}",
+            fontsize=10,
+        )
+        axis.legend(loc="lower right", fontsize=8, markerscale=0.6)
     figure.suptitle(f"{problem}: BalancedRRTConnect with balance_tree_sizes on / off, seed {seed}")
     figure.text(0.5, 0.005, TREES_CAPTION, ha="center", va="bottom", fontsize=8, wrap=True)
     figure.get_layout_engine().set(rect=(0, 0.07, 1, 0.93))
