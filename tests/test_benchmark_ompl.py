@@ -14,6 +14,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 from ompl import base as ob
 from ompl import geometric as og
@@ -108,15 +109,19 @@ def test_database_equals_ompl_statistics_script_table_by_table(arena, tmp_path):
     out, records = arena
     ours = dump(out / "benchmark.db")
     theirs = dump(ompl_script_database(sorted((out / "logs").glob("*.log")), tmp_path / "ompl.db"))
-    assert set(ours) == set(theirs) == {
-        "experiments",
-        "plannerConfigs",
-        "enums",
-        "runs",
-        "progress",
-        "bestPlannerConfigs",
-        "bestPlannerConfigsPerExperiment",
-    }
+    assert (
+        set(ours)
+        == set(theirs)
+        == {
+            "experiments",
+            "plannerConfigs",
+            "enums",
+            "runs",
+            "progress",
+            "bestPlannerConfigs",
+            "bestPlannerConfigsPerExperiment",
+        }
+    )
     for name in theirs:
         assert ours[name][:3] == theirs[name][:3], name  # kind, schema, columns
         assert ours[name][3] == theirs[name][3], name  # rows
@@ -278,18 +283,33 @@ def test_plot_draws_median_best_cost_against_time(arena):
     assert {"progress_narrow_gap.png", "success_vs_time.png", "narrow_gap.png", "trees_narrow_gap.png"} <= written
 
 
-def test_median_best_cost_holds_each_runs_last_sample():
+def test_median_best_cost_holds_each_runs_last_value():
     from ompl_balance.bench.plots import median_best_cost
 
-    def run(samples):
-        return {"progress": {"properties": ["best cost REAL", "time REAL"], "samples": samples}}
+    def run(samples, end, solution=None):
+        properties = {"time REAL": end, "solved BOOLEAN": int(solution is not None)}
+        if solution is not None:
+            properties["solution length REAL"] = solution
+        return {
+            "properties": properties,
+            "progress": {"properties": ["best cost REAL", "time REAL"], "samples": samples},
+        }
 
     runs = [
-        run([["inf", "0.05"], ["3", "0.10"], ["2", "0.15"]]),
-        run([["5", "0.05"], ["4", "0.10"]]),
-        run([["inf", "0.05"], ["inf", "0.10"], ["1", "0.15"]]),
+        run([["inf", "0.05"], ["3", "0.10"], ["2", "0.15"]], 0.2, 1.5),  # improves to 1.5 by its end
+        run([["5", "0.05"], ["4", "0.10"]], 0.12, 4.0),
+        run([["inf", "0.05"], ["inf", "0.10"]], 0.14),  # never solved
+        run([], 0.01, 6.0),  # solved before the first sample
     ]
-    grid = [0.0, 0.05, 0.1, 0.12, 0.15, 0.3]
-    # per time: the three runs' values (inf before a sample or a path), then their median
-    expected = [math.inf, math.inf, 4.0, 4.0, 2.0, 2.0]
-    assert list(median_best_cost(runs, grid)) == expected
+    grid = [0.0, 0.01, 0.05, 0.1, 0.15, 0.3]
+    # the four runs' values per time (inf before a value or a path), then their median
+    by_time = [
+        [math.inf, math.inf, math.inf, math.inf],
+        [math.inf, math.inf, math.inf, 6.0],
+        [math.inf, 5.0, math.inf, 6.0],
+        [3.0, 4.0, math.inf, 6.0],
+        [2.0, 4.0, math.inf, 6.0],
+        [1.5, 4.0, math.inf, 6.0],
+    ]
+    expected = [float(np.median(values)) for values in by_time]
+    assert list(median_best_cost(runs, np.array(grid))) == expected

@@ -126,8 +126,10 @@ def _import_function(reference: str) -> Callable:
     return function
 
 
-#: Planners built to try parameters, never destroyed: some crash when destroyed (OMPL 2.0.1's AORRTC).
-_TRIED_PLANNERS: list[ob.Planner] = []
+#: Stock planners that crash the process when destroyed (OMPL 2.0.1), and those of them built
+#: to try parameters, kept for the life of the process.
+CRASH_WHEN_DESTROYED = ("AORRTC",)
+_KEPT_PLANNERS: list[ob.Planner] = []
 
 
 @dataclass(frozen=True)
@@ -178,7 +180,8 @@ class PlannerSpec:
         si = ob.SpaceInformation(space)
         si.setStateValidityChecker(lambda state: True)
         planner = known[self.name](si)
-        _TRIED_PLANNERS.append(planner)
+        if self.name in CRASH_WHEN_DESTROYED:
+            _KEPT_PLANNERS.append(planner)
         for name, value in self.params.items():
             try:
                 set_planner_param(planner, name, value)

@@ -78,8 +78,11 @@ def _time_axis(axis: Any, times: Sequence[float]) -> None:
         return
     low, high = min(positive), max(positive)
     if high > 10 * low:
+        from matplotlib.ticker import NullFormatter
+
         axis.set_xscale("log")
         axis.set_xlim(low / 1.2, high * 1.2)
+        axis.xaxis.set_minor_formatter(NullFormatter())  # labels at the decades only: no overlaps
     else:
         margin = 0.05 * (high - low) or 0.05 * high
         axis.set_xlim(max(0.0, low - margin), high + margin)
@@ -151,23 +154,28 @@ def plot_success(records: Sequence[Record], experiment: Experiment, path: Path) 
 
 
 def _best_cost_series(record: Record) -> tuple[np.ndarray, np.ndarray] | None:
-    """``(times, best costs)`` of a run's progress samples (``inf`` before a path), or ``None``."""
+    """``(times, best costs)`` of a run whose planner reports its best cost while it runs: the
+    progress samples (``inf`` before a path), then the cost of its solution when the solve
+    ended (``time REAL``). ``None`` for a run without that progress property."""
     progress = record.get("progress")
-    if not progress:
-        return None
-    names = progress["properties"]
+    names = progress["properties"] if progress else []
     column = next((names.index(n) for n in BEST_COST_PROPERTIES if n in names), None)
-    if column is None or not progress["samples"]:
+    if column is None or record["properties"].get("time REAL") is None:
         return None
     time_column = names.index("time REAL")
-    times = np.array([float(sample[time_column]) for sample in progress["samples"]])
-    costs = np.array([float(sample[column]) if sample[column] else math.inf for sample in progress["samples"]])
-    return times, costs
+    times = [float(sample[time_column]) for sample in progress["samples"]]
+    costs = [float(sample[column]) if sample[column] else math.inf for sample in progress["samples"]]
+    end = record["properties"]["time REAL"]
+    solved = record["properties"].get("solved BOOLEAN") and "solution length REAL" in record["properties"]
+    if not times or end > times[-1]:
+        times.append(end)
+        costs.append(record["properties"]["solution length REAL"] if solved else (costs or [math.inf])[-1])
+    return np.array(times), np.array(costs)
 
 
 def median_best_cost(records: Sequence[Record], grid: np.ndarray) -> np.ndarray:
-    """Median over runs of the best cost at each time of ``grid`` (each run's last sample at or
-    before it, ``inf`` before its first sample or path; a run's last value holds after it ends)."""
+    """Median over runs of the best cost at each time of ``grid``: each run's value at or before
+    it (``inf`` before its first value or path), its last value holding after it ends."""
     values = []
     for record in records:
         series = _best_cost_series(record)
@@ -182,24 +190,32 @@ def median_best_cost(records: Sequence[Record], grid: np.ndarray) -> np.ndarray:
 
 
 def plot_progress(records: Sequence[Record], experiment: Experiment, problem: str, path: Path) -> Path | None:
-    """Median best cost against time per planner on ``problem``; ``None`` when no planner reports one."""
+    """Median best cost against time per planner that reports it while it runs, on ``problem``;
+    ``None`` when no such planner has a median path at any time."""
     series = {id(r): s for r in records if r["problem"] == problem and (s := _best_cost_series(r)) is not None}
     mine = [r for r in records if id(r) in series]
     if not mine:
         return None
     plt = _pyplot()
-    grid = np.linspace(0.0, max(times[-1] for times, _ in series.values()), 200)
     figure, axis = plt.subplots(figsize=(7, 4.5), layout="constrained")
+    _time_axis(axis, [t for times, _ in series.values() for t in times])
+    low, high = axis.get_xlim()
+    grid = np.geomspace(low, high, 300) if axis.get_xscale() == "log" else np.linspace(low, high, 300)
+    drawn = False
     for planner, style in zip(experiment.planners, _styles()):
         runs = [r for r in mine if r["planner"] == planner.label]
-        if runs:
-            median = median_best_cost(runs, grid)
+        median = median_best_cost(runs, grid)
+        if runs and np.isfinite(median).any():
             shown = np.where(np.isfinite(median), median, np.nan)  # no line until half the runs have a path
-            axis.plot(grid, shown, label=f"{planner.label} ({len(runs)} runs)", markevery=20, markersize=4, **style)
+            axis.plot(grid, shown, label=f"{planner.label} ({len(runs)} runs)", markevery=30, markersize=4, **style)
+            drawn = True
+    if not drawn:
+        plt.close(figure)
+        return None
     axis.set_xlabel("time (s)")
     axis.set_ylabel("median best cost (path length)")
     axis.legend(fontsize=8)
-    figure.suptitle(f"{problem}: median best cost while planning (sampled every 0.05 s)")
+    figure.suptitle(f"{problem}: median best cost while planning (sampled every 0.05 s, then at the end)")
     figure.savefig(path, dpi=120)
     plt.close(figure)
     return path
