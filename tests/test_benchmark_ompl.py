@@ -139,7 +139,7 @@ def test_progress_rows_for_both_rrtstar_planners(arena):
             series = {name: [sample[names.index(name)] for sample in progress["samples"]] for name in names}
             times = [float(t) for t in series["time REAL"]]
             assert len(times) >= 3, "sampled every 0.05 s during a 0.3 s solve"
-            assert times == sorted(times) and 0 < times[0] and times[-1] <= record["properties"]["time REAL"]
+            assert times == sorted(times) and times[0] > 0 and times[-1] <= record["properties"]["time REAL"]
             iterations = [int(i) for i in series["iterations INTEGER"]]
             assert iterations == sorted(iterations) and iterations[-1] > 0
             costs = [float(c) for c in series["best cost REAL"]]
@@ -226,7 +226,7 @@ def test_declared_parameter_table_reads_and_sets_every_bound_planner(planner_nam
         "longest_valid_segment_fraction",
         "valid_segment_count_factor",
     }
-    for name, (kind, setter, getter) in DECLARED_PARAMS[planner_name].items():
+    for name, (kind, _setter, getter) in DECLARED_PARAMS[planner_name].items():
         if (planner_name, name) in IGNORED_BY_OMPL:
             continue
         if not hasattr(planner, getter):  # bound neither way (BFMT's balanced, optimality): logged empty
