@@ -157,8 +157,8 @@ def _best_cost_series(record: Record) -> tuple[np.ndarray, np.ndarray] | None:
     """``(times, best costs)`` of a run whose planner reports its best cost while it runs: the
     progress samples (``inf`` before a path), then the cost of its solution when the solve
     ended (``time REAL``). ``None`` for a run without that progress property."""
-    progress = record.get("progress")
-    names = progress["properties"] if progress else []
+    progress = record.get("progress") or {"properties": [], "samples": []}
+    names = progress["properties"]
     column = next((names.index(n) for n in BEST_COST_PROPERTIES if n in names), None)
     if column is None or record["properties"].get("time REAL") is None:
         return None
