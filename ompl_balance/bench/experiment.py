@@ -45,7 +45,6 @@ keys, planners or parameters, missing files, bad ids and non-positive numbers ra
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import importlib
 import json
@@ -55,7 +54,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field, fields
 from importlib import metadata
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ompl import base as ob
 from ompl import geometric as og
@@ -65,10 +64,6 @@ from ..planners import PRESETS
 from ..rrtstar import BallRadiusRRTstar
 from ..worlds.boxes import PROBLEMS
 from .planner_params import set_planner_param
-
-if TYPE_CHECKING:
-    from ..collision.kinematics import RobotModel
-    from ..worlds.mbm import MBMProblem
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -218,53 +213,15 @@ class ProblemSpec:
         if self.kind == "builtin":
             ss = PROBLEMS[self.source].setup()
         elif self.kind == "mbm":
-            ss = _mbm_problem(self.source, self.problem_id, self.robot).simple_setup(_robot(self.robot))
+            from ..worlds.mbm import problem_setup
+
+            ss = problem_setup(self.source, self.problem_id, self.robot)
         else:
             ss = _import_function(self.source)(**self.args)
             if not isinstance(ss, og.SimpleSetup):
                 raise TypeError(f"problem factory {self.source} returned {type(ss).__name__}, not og.SimpleSetup")
         ensure_counting(ss.getSpaceInformation())
         return ss
-
-
-@functools.lru_cache(maxsize=4)
-def _robot(robot_dir: str) -> RobotModel:
-    """The robot of a folder (``""``: the Panda shipped with the package), loaded once per process."""
-    from ..collision.robots import load_panda_vamp
-
-    return load_panda_vamp(robot_dir or None)
-
-
-@functools.lru_cache(maxsize=16)
-def _mbm_scenario(source: str, robot_dir: str) -> dict[int, MBMProblem]:
-    """A MotionBenchMaker scenario's problems by id, joints ordered as the robot's; loaded once per process."""
-    from ..worlds.mbm import load_mbm
-
-    return {problem.id: problem for problem in load_mbm(source, _robot(robot_dir).joint_names)}
-
-
-def _mbm_problem(source: str, problem_id: int, robot_dir: str) -> MBMProblem:
-    return _mbm_scenario(source, robot_dir)[problem_id]
-
-
-def load_shipped_mbm_data() -> None:
-    """Load the shipped Panda and MotionBenchMaker scenarios into this process's caches.
-
-    The forkserver of a sweep with MotionBenchMaker problems calls this (by importing
-    :mod:`ompl_balance.bench.preload_mbm`), so every run's process, forked from it,
-    starts with them instead of parsing them again (~0.1 s a run).
-    """
-    from ..worlds.mbm import SCENARIOS
-
-    for scenario in SCENARIOS:
-        _mbm_scenario(scenario, "")
-
-
-def _files_digest(paths: Sequence[Path]) -> str:
-    digest = hashlib.blake2b(digest_size=8)
-    for path in paths:
-        digest.update(path.read_bytes())
-    return digest.hexdigest()
 
 
 def mbm_problems(scenario: str, ids: Sequence[int] | None = None, robot: str = "") -> list[ProblemSpec]:
@@ -284,12 +241,12 @@ def mbm_problems(scenario: str, ids: Sequence[int] | None = None, robot: str = "
 
 def _mbm_specs(name: str, source: str, ids: Sequence[int], robot: str) -> list[ProblemSpec]:
     """Specs of the problems ``ids`` of a scenario, with the digest of its files unless shipped."""
-    from ..worlds.mbm import SCENARIOS
+    from ..worlds.mbm import SCENARIOS, files_digest
 
     files = [] if source in SCENARIOS else [Path(source)]
     if robot:
         files += [Path(robot) / "panda.urdf", Path(robot) / "panda.srdf"]
-    data = _files_digest(files) if files else ""
+    data = files_digest(files) if files else ""
     return [ProblemSpec(f"{name}.{i:03d}", "mbm", source, problem_id=i, robot=robot, data=data) for i in ids]
 
 

@@ -77,7 +77,7 @@ def describe_changes(previous: Mapping[str, Any], current: Mapping[str, Any]) ->
             differing = [
                 f"{name} {old.get(name)!r} -> {value!r}"
                 for name, value in item.items()
-                if old and old.get(name) != value
+                if old and (name in old or value) and old.get(name) != value  # a new empty field is no change
             ]
             if differing:
                 changes.append(f"{kind} {item[key]!r}: {', '.join(differing)}")

@@ -7,8 +7,8 @@ random number of a process, so each run seeds it with its own seed
 (:func:`~ompl_balance.bench.experiment.run_seed`) and stock planners repeat too; and a run
 that segfaults, aborts or ignores its time limit takes only its own process down. The
 parent waits at most ``task.hard_limit`` seconds (2 x the time limit + a margin:
-planning, then simplification bounded by the time limit) and records ``CRASH`` or
-``TIMEOUT`` for a process that died or had to be killed.
+planning, then simplification bounded by the time limit) and records OMPL's ``CRASH``
+status for a process that died or had to be killed.
 
 Results go to ``results.jsonl`` in the output folder, one JSON record per run, written
 and flushed as each run finishes (:class:`ResultStore`); runs already there are skipped

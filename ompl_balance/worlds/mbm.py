@@ -11,7 +11,10 @@ The package ships four scenarios of MotionBenchMaker's Panda set, 100 problems e
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -148,3 +151,46 @@ def _problem(record: Any, scenario: str, column: list[int], where: str) -> MBMPr
     return MBMProblem(
         scenario, int(_field(record, "id", where)), start, goals, environment, bool(record.get("valid", True))
     )
+
+
+# -- problems of benchmark runs -------------------------------------------------------
+
+
+@functools.lru_cache(maxsize=4)
+def _robot(robot_dir: str) -> RobotModel:
+    """The robot of a folder (``""``: the Panda shipped with the package), loaded once per process."""
+    from ..collision.robots import load_panda_vamp
+
+    return load_panda_vamp(robot_dir or None)
+
+
+@functools.lru_cache(maxsize=16)
+def _scenario(source: str, robot_dir: str) -> dict[int, MBMProblem]:
+    """A scenario's problems by id, joints ordered as the robot's; loaded once per process."""
+    return {problem.id: problem for problem in load_mbm(source, _robot(robot_dir).joint_names)}
+
+
+def problem_setup(source: str, problem_id: int, robot_dir: str = "") -> og.SimpleSetup:
+    """The ``SimpleSetup`` of problem ``problem_id`` of scenario ``source`` (a shipped name or a
+    file) for the robot in ``robot_dir`` (``""``: the shipped Panda). Robot and scenario are read
+    once per process."""
+    return _scenario(source, robot_dir)[problem_id].simple_setup(_robot(robot_dir))
+
+
+def load_shipped_data() -> None:
+    """Read the shipped Panda and scenarios into the caches of :func:`problem_setup`.
+
+    The forkserver of a benchmark sweep with MotionBenchMaker problems calls this (by
+    importing :mod:`ompl_balance.bench.preload_mbm`), so every run's process, forked from
+    it, starts with them instead of reading them again (~0.1 s a run).
+    """
+    for scenario in SCENARIOS:
+        _scenario(scenario, "")
+
+
+def files_digest(paths: Sequence[Path]) -> str:
+    """A short hash of the files' contents (a problem read from them changes when they do)."""
+    digest = hashlib.blake2b(digest_size=8)
+    for path in paths:
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
