@@ -10,8 +10,9 @@
     runs an experiment file (docs/benchmark.md) into ``OUT/``: results, OMPL logs, the
     SQLite database and the summary; running it again resumes.
 ``ompl-balance plot OUT/``
-    box plots, success-vs-time curves, the summary table and, for 2-D problems, the
-    two trees of balanced and alternating growth (needs matplotlib: the ``plot`` extra).
+    box plots, success-vs-time curves, median best cost against time (RRT*), the summary
+    table and, for 2-D problems, the two trees of balanced and alternating growth (needs
+    matplotlib: the ``plot`` extra).
 ``ompl-balance gamma``
     RRT*'s ball-radius constant for a built-in problem or an occupancy grid, and the
     ``rewire_factor`` that gives OMPL's ``RRTstar`` the same radius schedule.

@@ -40,10 +40,15 @@ class Claim:
         if not self.superseded:
             return ""
         what = "; ".join(self.changes) or "runs recorded under another definition (experiment.json gives no details)"
+        runs, cells = _count(self.superseded, "run"), _count(len(self.cells), "cell")
         return (
-            f"{out} holds runs of another definition ({what}): {self.superseded} runs of {len(self.cells)} "
-            f"cells moved to {SUPERSEDED_FILE} and run again; {self.kept} finished runs kept"
+            f"{out} holds runs of another definition ({what}): {runs} of {cells} moved to {SUPERSEDED_FILE} "
+            f"and run again; {_count(self.kept, 'finished run')} kept"
         )
+
+
+def _count(number: int, noun: str) -> str:
+    return f"{number} {noun}{'s' * (number != 1)}"
 
 
 def experiment_file_content(experiment: Experiment) -> dict[str, Any]:
