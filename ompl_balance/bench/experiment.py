@@ -7,7 +7,7 @@ Experiments come from TOML files (:func:`load_experiment`) or from Python::
     name = "narrow"            # no spaces; names the OMPL logs
     runs = 5                   # runs per (problem, planner) cell
     time_limit = 1.0           # seconds of planning per run
-    memory_limit = 0           # MB per run process, 0 = no limit
+    memory_limit = 0           # MB a run may add to its memory (as OMPL), 0 = no limit
     seed = 1                   # decides every run's seed (see run_seed)
     baseline = "RRTConnect"    # planner label the summary's ratios refer to
 
@@ -283,7 +283,7 @@ class RunTask:
     run: int  # 0-based index within its cell
     seed: int
     time_limit: float  # s of planning (and again at most as much for simplification)
-    memory_limit: float  # MB for the run's process, 0 = no limit
+    memory_limit: float  # MB the run may add to its process's memory (runner.MemoryLimit), 0 = no limit
     hard_limit: float  # s of wall clock after which the run's process is killed
     definition: str = ""  # digest of the cell's definition (Experiment.cell_definition)
 
