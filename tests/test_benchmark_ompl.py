@@ -60,7 +60,8 @@ def hoarding_planner(si: ob.SpaceInformation) -> ob.Planner:
 
 @pytest.fixture(scope="module")
 def arena(tmp_path_factory):
-    """Stock RRTConnect and RRTstar, BallRadiusRRTstar and a raising planner on narrow_gap."""
+    """Stock RRTConnect and RRTstar, BallRadiusRRTstar, BalancedRRTConnect (progress properties,
+    but done before the first sample) and a raising planner on narrow_gap."""
     out = tmp_path_factory.mktemp("arena")
     experiment = Experiment(
         name="arena",
@@ -69,6 +70,7 @@ def arena(tmp_path_factory):
             PlannerSpec("RRTConnect", "RRTConnect"),
             PlannerSpec("RRTstar", "RRTstar"),
             PlannerSpec("BallRadiusRRTstar", "BallRadiusRRTstar"),
+            PlannerSpec("BalancedRRTConnect", "BalancedRRTConnect"),
             PlannerSpec("raising", factory="test_benchmark_ompl:raising_planner"),
         ),
         runs=2,
@@ -125,8 +127,9 @@ def test_database_equals_ompl_statistics_script_table_by_table(arena, tmp_path):
     for name in theirs:
         assert ours[name][:3] == theirs[name][:3], name  # kind, schema, columns
         assert ours[name][3] == theirs[name][3], name  # rows
-    assert len(ours["runs"][3]) == len(records) == 8
-    assert len(ours["bestPlannerConfigs"][3]) == 4  # one row per planner name
+    assert len(ours["runs"][3]) == len(records) == 10
+    assert len(ours["bestPlannerConfigs"][3]) == 5  # one row per planner name
+    assert all("progress" in r for r in _by_planner(records, "BalancedRRTConnect"))  # few or no samples
 
 
 def test_progress_rows_for_both_rrtstar_planners(arena):
@@ -150,8 +153,9 @@ def test_progress_rows_for_both_rrtstar_planners(arena):
             if label == "BallRadiusRRTstar":
                 assert iterations[-1] <= record["properties"]["iterations INTEGER"]
     samples = {
-        label: sum(len(r["progress"]["samples"]) for r in _by_planner(records, label))
-        for label in ("RRTstar", "BallRadiusRRTstar")
+        label: count
+        for label in ("RRTstar", "BallRadiusRRTstar", "BalancedRRTConnect")
+        if (count := sum(len(r["progress"]["samples"]) for r in _by_planner(records, label)))
     }
     with sqlite3.connect(out / "benchmark.db") as db:
         rows = dict(
