@@ -63,7 +63,7 @@ from ..core.counting import ensure_counting
 from ..planners import PRESETS
 from ..rrtstar import BallRadiusRRTstar
 from ..worlds.boxes import PROBLEMS
-from .planner_params import set_planner_param
+from .planner_params import DECLARED_PARAMS, check_declared_param, set_planner_param
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -121,12 +121,6 @@ def _import_function(reference: str) -> Callable:
     return function
 
 
-#: Stock planners that crash the process when destroyed (OMPL 2.0.1), and those of them built
-#: to try parameters, kept for the life of the process.
-CRASH_WHEN_DESTROYED = ("AORRTC",)
-_KEPT_PLANNERS: list[ob.Planner] = []
-
-
 @dataclass(frozen=True)
 class PlannerSpec:
     """A planner of the experiment.
@@ -168,15 +162,18 @@ class PlannerSpec:
             raise ExperimentError(
                 "name", f"unknown planner {self.name!r}; known: {', '.join(sorted(known))}", self.name
             )
-        if not self.params:
+        if self.name in DECLARED_PARAMS:  # a stock planner: checked against OMPL's names, not built
+            for name, value in self.params.items():
+                try:
+                    check_declared_param(self.name, name, value)
+                except ValueError as error:
+                    raise ExperimentError(f"params.{name}", str(error)) from error
             return
         space = ob.RealVectorStateSpace(2)
         space.setBounds(0.0, 1.0)
         si = ob.SpaceInformation(space)
         si.setStateValidityChecker(lambda state: True)
         planner = known[self.name](si)
-        if self.name in CRASH_WHEN_DESTROYED:
-            _KEPT_PLANNERS.append(planner)
         for name, value in self.params.items():
             try:
                 set_planner_param(planner, name, value)

@@ -226,14 +226,31 @@ def set_planner_param(planner: ob.Planner, name: str, value: str) -> None:
             raise ValueError(f"bad value {value!r} for {name!r}; accepted: {params.getRangeSuggestion(name)}")
         return
     stock = _stock_params(planner)
-    if name not in stock:
-        raise ValueError(f"unknown parameter {name!r}; {planner.getName()} has {', '.join(sorted(stock)) or 'none'}")
-    kind, setter, _getter = stock[name]
+    setter, converted = _stock_value(planner.getName(), stock, name, value)
     if not hasattr(planner, setter):
         raise ValueError(f"{name!r} cannot be set from Python: OMPL's bindings do not bind {setter}")
     try:
-        getattr(planner, setter)(_from_text(kind, value))
+        getattr(planner, setter)(converted)
     except (TypeError, ValueError) as error:
+        raise ValueError(f"bad value {value!r} for {name!r}: {error}") from error
+
+
+def check_declared_param(planner_class: str, name: str, value: str) -> None:
+    """:func:`set_planner_param`'s checks for a stock planner of :data:`DECLARED_PARAMS`, without
+    building one (some stock planners crash the process when destroyed: OMPL 2.0.1's AORRTC)."""
+    _stock_value(planner_class, DECLARED_PARAMS[planner_class], name, value)
+
+
+def _stock_value(
+    planner: str, params: dict[str, tuple[str, str, str]], name: str, value: str
+) -> tuple[str, bool | int | float]:
+    """The setter of stock parameter ``name`` and ``value`` converted to its type; ``ValueError``."""
+    if name not in params:
+        raise ValueError(f"unknown parameter {name!r}; {planner} has {', '.join(sorted(params)) or 'none'}")
+    kind, setter, _getter = params[name]
+    try:
+        return setter, _from_text(kind, value)
+    except ValueError as error:
         raise ValueError(f"bad value {value!r} for {name!r} ({kind}): {error}") from error
 
 
