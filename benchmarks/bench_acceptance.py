@@ -37,7 +37,8 @@ from acceptance import (
     run_2d_circles_test,
     run_2d_map_test,
 )
-from ompl_envs import RESOURCES, Circles2D, load_circles, load_environment, load_queries
+
+from ompl_balance.worlds.ompl_2d import RESOURCES, Circles2D, load_circles, load_environment, load_queries
 
 
 class TimedCircles(Circles2D):

@@ -2,15 +2,17 @@
 
 ``ompl-balance compare``
     stock ``og.RRTConnect`` against ``BalancedRRTConnect`` (balancing on and off), or
-    the planners given with ``--planners``, on the built-in 2-D problems; prints per
-    problem the success rate, median time and median validity checks, each with its
-    95 % interval and its ratio to stock RRT-Connect.
+    the planners given with ``--planners``, on the built-in 2-D problems and problem 1 of
+    each MotionBenchMaker Panda scenario; prints per problem the success rate, median
+    time, validity checks and nodes, each with its 95 % interval and its ratio to stock
+    RRT-Connect. With ``-o OUT`` the runs are kept, and the same command resumes.
 ``ompl-balance bench EXPERIMENT.toml -o OUT/``
     runs an experiment file (docs/benchmark.md) into ``OUT/``: results, OMPL logs, the
     SQLite database and the summary; running it again resumes.
 ``ompl-balance plot OUT/``
-    box plots, success-vs-time curves, the summary table and, for 2-D problems, the
-    two trees of balanced and alternating growth (needs matplotlib: the ``plot`` extra).
+    box plots, success-vs-time curves, median best cost against time (RRT*), the summary
+    table and, for 2-D problems, the two trees of balanced and alternating growth (needs
+    matplotlib: the ``plot`` extra).
 ``ompl-balance gamma``
     RRT*'s ball-radius constant for a built-in problem or an occupancy grid, and the
     ``rewire_factor`` that gives OMPL's ``RRTstar`` the same radius schedule.
@@ -30,8 +32,16 @@ from pathlib import Path
 import numpy as np
 from ompl import util as ou
 
-from .bench.compare import bench, compare_experiment, parse_planners
-from .bench.experiment import Experiment, ExperimentError, load_experiment
+from .bench.compare import (
+    COMPARE_MBM_PROBLEMS,
+    COMPARE_SEED,
+    bench,
+    compare_experiment,
+    compare_problem,
+    parse_planners,
+)
+from .bench.experiment import Experiment, ExperimentError, MissingExtraError, PlannerSpec, load_experiment
+from .bench.runner import require_dask
 from .gamma import ball_radius_constant, estimate_free_measure, ompl_rewire_factor, rewire_radius
 from .worlds.boxes import PROBLEMS
 from .worlds.occupancy import OCCUPANCY_PROBLEMS, OccupancyGrid, OccupancyProblem
@@ -39,15 +49,17 @@ from .worlds.occupancy import OCCUPANCY_PROBLEMS, OccupancyGrid, OccupancyProble
 
 def _problem_names(text: str) -> list[str]:
     names = [name.strip() for name in text.split(",") if name.strip()]
-    unknown = [name for name in names if name not in PROBLEMS]
-    if unknown or not names:
-        raise argparse.ArgumentTypeError(
-            f"unknown problem(s) {', '.join(unknown) or '(none given)'}; choose from {', '.join(PROBLEMS)}"
-        )
+    if not names:
+        raise argparse.ArgumentTypeError("no problem given")
+    for name in names:
+        try:
+            compare_problem(name)
+        except ValueError as error:
+            raise argparse.ArgumentTypeError(str(error)) from error
     return names
 
 
-def _planners(text: str):
+def _planners(text: str) -> list[PlannerSpec]:
     try:
         return parse_planners(text)
     except ValueError as error:
@@ -97,7 +109,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     compare = commands.add_parser(
         "compare",
-        help="compare planners with stock RRTConnect on the built-in problems",
+        help="compare planners with stock RRTConnect on 2-D and Panda problems",
         description=__doc__.split("\n\n", 1)[1],
     )
     compare.add_argument("--runs", type=_positive_int, default=20, help="runs per planner and problem (default 20)")
@@ -107,8 +119,9 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument(
         "--problems",
         type=_problem_names,
-        default=list(PROBLEMS),
-        help=f"comma-separated problem names (default: all of {', '.join(PROBLEMS)})",
+        default=[*PROBLEMS, *COMPARE_MBM_PROBLEMS],
+        help=f"comma-separated problems: built-in 2-D ({', '.join(PROBLEMS)}) and MotionBenchMaker Panda "
+        f"problems SCENARIO.ID (default: all 2-D ones and {', '.join(COMPARE_MBM_PROBLEMS)})",
     )
     compare.add_argument(
         "--planners",
@@ -121,10 +134,17 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument(
         "--seed",
         type=_positive_int,
-        default=None,
-        help="experiment seed; every run's seed derives from it (default: drawn and printed)",
+        default=COMPARE_SEED,
+        help=f"experiment seed; every run's seed derives from it (default {COMPARE_SEED})",
     )
-    compare.add_argument("-o", "--out", type=Path, default=None, help="keep results, logs and database in this folder")
+    compare.add_argument(
+        "-o",
+        "--out",
+        type=Path,
+        default=None,
+        help="keep results, logs and database in this folder (the same command then resumes); "
+        "default: a temporary folder, deleted at the end",
+    )
     _add_execution_options(compare)
 
     bench_parser = commands.add_parser("bench", help="run an experiment file into an output folder (resumes)")
@@ -179,11 +199,38 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _run(experiment: Experiment, out: Path, args: argparse.Namespace) -> int:
+def _run(experiment: Experiment, out: Path, args: argparse.Namespace, temporary: bool = False) -> int:
     records = bench(experiment, out, jobs=args.jobs, dask=args.dask, progress=not args.no_progress)
     print((out / "summary.md").read_text(), end="")
     crashed = sum(bool(r["error"]) for r in records)
-    print(f"\n{len(records)} runs in {out}" + (f", {crashed} crashed or killed (see results.jsonl)" if crashed else ""))
+    where = "in a temporary folder, now deleted (-o OUT keeps results, logs and database)" if temporary else f"in {out}"
+    print(f"\n{len(records)} runs {where}" + (f"; {crashed} crashed or killed (see results.jsonl)" if crashed else ""))
+    return 0
+
+
+def _interrupted(args: argparse.Namespace) -> str:
+    """What Ctrl-C leaves behind, for the command that was interrupted."""
+    out = getattr(args, "out", None)
+    if args.command in ("compare", "bench") and out is not None:
+        return f"interrupted: the finished runs are kept in {out}; run the same command again to resume"
+    if args.command == "compare":
+        return "interrupted: without -o the runs were made in a temporary folder, now deleted; give -o OUT to keep them and resume"
+    return "interrupted"
+
+
+def _plot(args: argparse.Namespace) -> int:
+    """``ompl-balance plot``: the plots and tables of an output folder."""
+    from .bench.plots import plot_folder, require_matplotlib
+
+    if not (args.out / "experiment.json").is_file():
+        raise ExperimentError(
+            str(args.out),
+            "is not an output folder (no experiment.json): make one with 'ompl-balance bench EXPERIMENT.toml "
+            f"-o {args.out}' or 'ompl-balance compare -o {args.out}'",
+        )
+    require_matplotlib()
+    for path in plot_folder(args.out, baseline=args.baseline, tree_iterations=args.tree_iterations):
+        print(path)
     return 0
 
 
@@ -242,28 +289,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
     ou.setLogLevel(ou.LOG_WARN)
     try:
+        if getattr(args, "dask", None):
+            require_dask()
         if args.command == "compare":
             experiment = compare_experiment(args.problems, args.planners, args.runs, args.time_limit, args.seed)
             print(f"experiment seed {experiment.seed}")
             if args.out is not None:
                 return _run(experiment, args.out, args)
             with tempfile.TemporaryDirectory(prefix="ompl-balance-compare-") as out:
-                return _run(experiment, Path(out), args)
+                return _run(experiment, Path(out), args, temporary=True)
         if args.command == "bench":
             return _run(load_experiment(args.experiment), args.out, args)
         if args.command == "plot":
-            from .bench.plots import plot_folder
-
-            for path in plot_folder(args.out, baseline=args.baseline, tree_iterations=args.tree_iterations):
-                print(path)
-            return 0
+            return _plot(args)
         if args.command == "gamma":
             return _gamma(args, parser)
-    except ExperimentError as error:
+    except (ExperimentError, MissingExtraError) as error:
         print(f"ompl-balance {args.command}: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("\ninterrupted: finished runs are kept; run the same command again to resume", file=sys.stderr)
+        print(f"\n{_interrupted(args)}", file=sys.stderr)
         return 130
     return 0
 

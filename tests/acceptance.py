@@ -44,10 +44,16 @@ from dataclasses import dataclass, field
 
 from ompl import base as ob
 from ompl import geometric as og
-from ompl_envs import CircleQuery, Circles2D, Environment2D, circles_space_information, map_space_information
 from pathcheck import invalid_points
 
 from ompl_balance import PRESETS, BalancedRRTConnect, BallRadiusRRTstar, read_work
+from ompl_balance.worlds.ompl_2d import (
+    CircleQuery,
+    Circles2D,
+    Environment2D,
+    circles_space_information,
+    map_space_information,
+)
 
 SOLUTION_TIME = 1.0  # s, per solve and per simplification
 MAP_RUNS = 100  # run2DMapTest's N

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import json
+import shutil
 import sqlite3
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from ompl import geometric as og
 
 from ompl_balance.bench.compare import bench, compare_experiment, parse_planners
 from ompl_balance.bench.experiment import (
@@ -22,6 +25,9 @@ from ompl_balance.bench.logs import write_logs
 from ompl_balance.bench.runner import run_isolated
 from ompl_balance.bench.summary import summarize
 from ompl_balance.cli import main
+from ompl_balance.worlds.boxes import Problem
+
+REPO = Path(__file__).resolve().parents[1]
 
 GOOD = """\
 name = "tiny"
@@ -182,13 +188,138 @@ def test_a_run_re_executed_alone_repeats_its_result(tiny_sweep):
         assert deterministic(run_isolated(task)) == deterministic(by_key[task.key])
 
 
-def test_rerun_skips_finished_runs_and_more_runs_add_only_the_missing(tiny_sweep, tmp_path):
-    experiment, out, _records = tiny_sweep
-    lines = (out / "results.jsonl").read_text().splitlines()
-    bench(experiment, out, progress=False)
-    assert (out / "results.jsonl").read_text().splitlines() == lines  # nothing run again
-    with pytest.raises(ExperimentError, match="other time_limit"):
-        bench(Experiment(**{**experiment.__dict__, "time_limit": 3.0}), out, progress=False)
+def test_rerun_runs_nothing_and_more_runs_add_only_the_missing(tmp_path):
+    experiment = small()
+    first = bench(experiment, tmp_path, progress=False)
+    lines = (tmp_path / "results.jsonl").read_text().splitlines()
+    assert sorted(map(deterministic, bench(experiment, tmp_path, progress=False))) == sorted(map(deterministic, first))
+    assert (tmp_path / "results.jsonl").read_text().splitlines() == lines  # nothing run again
+    more = bench(small(runs=3), tmp_path, progress=False)
+    added = (tmp_path / "results.jsonl").read_text().splitlines()[len(lines) :]
+    assert sorted((r["problem"], r["planner"], r["run"]) for r in map(json.loads, added)) == sorted(
+        (p, q, 2) for p in ("open", "corner") for q in ("RRTConnect", "Balanced")
+    )
+    assert len(more) == 12
+
+
+def corner_world(goal: float) -> og.SimpleSetup:
+    """The open unit square from (0.1, 0.1) to (goal, goal) (a problem factory for the tests)."""
+    return Problem("corner", "open square", (), (0.1, 0.1), (goal, goal)).setup()
+
+
+def small(**changes) -> Experiment:
+    """Two problems x two planners x two runs, a second each; ``changes`` replace fields."""
+    fields = {
+        "name": "small",
+        "problems": (
+            ProblemSpec("open", "builtin", "open"),
+            ProblemSpec("corner", "factory", "test_benchmark:corner_world", args={"goal": 0.9}),
+        ),
+        "planners": (
+            PlannerSpec("RRTConnect", "RRTConnect", params={"range": "0.1"}),
+            PlannerSpec("Balanced", "BalancedRRTConnect"),
+        ),
+        "runs": 2,
+        "time_limit": 5.0,
+        "seed": 2,
+    }
+    return Experiment(**{**fields, **changes})
+
+
+@pytest.fixture(scope="module")
+def small_sweep(tmp_path_factory):
+    out = tmp_path_factory.mktemp("small")
+    return out, bench(small(), out, progress=False)
+
+
+ALL_CELLS = {(p, q) for p in ("open", "corner") for q in ("RRTConnect", "Balanced")}
+
+
+@pytest.mark.parametrize(
+    ("changes", "changed_cells", "message"),
+    [
+        (
+            {
+                "planners": (
+                    PlannerSpec("RRTConnect", "RRTConnect", params={"range": "0.3"}),
+                    PlannerSpec("Balanced", "BalancedRRTConnect"),
+                )
+            },
+            {("open", "RRTConnect"), ("corner", "RRTConnect")},
+            "planner 'RRTConnect': params {'range': '0.1'} -> {'range': '0.3'}",
+        ),
+        (
+            {
+                "planners": (
+                    PlannerSpec("RRTConnect", "RRTConnect", params={"range": "0.1"}),
+                    PlannerSpec("Balanced", "RRT"),
+                )
+            },
+            {("open", "Balanced"), ("corner", "Balanced")},
+            "planner 'Balanced': name 'BalancedRRTConnect' -> 'RRT'",
+        ),
+        (
+            {
+                "problems": (
+                    ProblemSpec("open", "builtin", "open"),
+                    ProblemSpec("corner", "factory", "test_benchmark:corner_world", args={"goal": 0.8}),
+                )
+            },
+            {("corner", "RRTConnect"), ("corner", "Balanced")},
+            "problem 'corner': args {'goal': 0.9} -> {'goal': 0.8}",
+        ),
+        ({"time_limit": 4.0}, ALL_CELLS, "time_limit 5.0 -> 4.0"),
+        ({"seed": 3}, ALL_CELLS, "seed 2 -> 3"),
+    ],
+    ids=["params", "planner", "problem", "time limit", "seed"],
+)
+def test_a_changed_definition_runs_exactly_the_changed_cells_again(
+    small_sweep, tmp_path, changes, changed_cells, message
+):
+    before, first = small_sweep
+    shutil.copytree(before, tmp_path, dirs_exist_ok=True)
+    notices: list[str] = []
+    experiment = small(**changes)
+    records = bench(experiment, tmp_path, progress=False, notify=notices.append)
+    tasks = {task.key: task for task in experiment.tasks()}
+    assert sorted((r["problem"], r["planner"], r["run"]) for r in records) == sorted(tasks)
+    earlier = {(r["problem"], r["planner"], r["run"]): r for r in first}
+    for record in records:
+        key = (record["problem"], record["planner"], record["run"])
+        assert record["definition"] == tasks[key].definition  # nothing reported from another definition
+        if key[:2] in changed_cells:
+            assert record["definition"] != earlier[key]["definition"]
+        else:
+            assert record == earlier[key]  # kept as it was
+    superseded = [json.loads(line) for line in (tmp_path / "superseded.jsonl").read_text().splitlines()]
+    assert sorted(json.dumps(r, sort_keys=True) for r in superseded) == sorted(
+        json.dumps(r, sort_keys=True) for r in first if (r["problem"], r["planner"]) in changed_cells
+    )
+    stored = [json.loads(line) for line in (tmp_path / "results.jsonl").read_text().splitlines()]
+    assert sorted(map(deterministic, stored)) == sorted(map(deterministic, records))  # no stale record left
+    (notice,) = notices
+    assert message in notice and f"{2 * len(changed_cells)} runs of {len(changed_cells)} cells" in notice
+    with sqlite3.connect(tmp_path / "benchmark.db") as db:
+        assert db.execute("SELECT COUNT(*) FROM runs").fetchone()[0] == 8
+        settings = "".join(row[0] for row in db.execute("SELECT settings FROM plannerConfigs"))
+    if "planners" in changes and "range" in message:
+        assert "range = 0.3" in settings and "range = 0.1" not in settings
+        assert all(r["params"]["range"] == "0.3" for r in records if r["planner"] == "RRTConnect")
+
+
+def test_experiment_files_use_only_the_data_shipped_with_the_package():
+    files = [*sorted((REPO / "experiments").glob("*.toml")), REPO / "examples" / "experiment.toml"]
+    assert len(files) >= 4
+    for path in files:
+        experiment = load_experiment(path)
+        for problem in experiment.problems:
+            assert problem.robot == "" and not Path(problem.source).is_absolute(), (path, problem.name)
+    outside = ("../" + "shared", "shared" + "/data")  # the data folder beside a development checkout
+    for folder in ("ompl_balance", "tests", "experiments", "examples"):
+        for path in (REPO / folder).rglob("*"):
+            if path.is_file() and path.suffix in (".py", ".toml", ".md", ".json", ".txt"):
+                text = path.read_text(errors="replace")
+                assert not any(word in text for word in outside), path
 
 
 def test_ompl_statistics_script_reads_the_logs(tiny_sweep, tmp_path):
@@ -226,6 +357,7 @@ def test_ompl_statistics_script_reads_the_logs(tiny_sweep, tmp_path):
             "tree_swaps",
             "validity_checks",
             "motion_checks",
+            "distance_queries",
             "seed",
         } <= columns
         checks = db.execute("SELECT SUM(validity_checks) FROM runs").fetchone()[0]

@@ -68,8 +68,8 @@ def test_crash_and_hang_are_recorded_and_the_sweep_goes_on(tmp_path):
         ("RRTConnect", 1): "EXACT_SOLUTION",
         ("segfault", 0): "CRASH",
         ("segfault", 1): "CRASH",
-        ("hang", 0): "TIMEOUT",
-        ("hang", 1): "TIMEOUT",
+        ("hang", 0): "CRASH",  # killed at the hard limit: OMPL's Benchmark called an overrun a crash
+        ("hang", 1): "CRASH",
     }
     errors = {r["planner"]: r["error"] for r in records}
     assert "SIGSEGV" in errors["segfault"] and "hard limit" in errors["hang"]
@@ -77,6 +77,7 @@ def test_crash_and_hang_are_recorded_and_the_sweep_goes_on(tmp_path):
     log = (tmp_path / "logs" / "failing.open.log").read_text()
     assert "\nsegfault\n" in log and "\nhang\n" in log  # failed runs are in the OMPL log too
     assert "2 crashed" in (tmp_path / "summary.md").read_text()
+    assert all(r["properties"]["status ENUM"] == 7 for r in records if r["planner"] != "RRTConnect")
 
 
 RESUME_TOML = """\
@@ -159,3 +160,63 @@ def test_dask_cluster_gives_the_results_of_the_local_pool(tmp_path, monkeypatch)
     assert sorted(map(deterministic, local)) == sorted(map(deterministic, distributed))
     logs = sorted(p.name for p in (tmp_path / "dask" / "logs").glob("*.log"))
     assert logs == sorted(p.name for p in (tmp_path / "local" / "logs").glob("*.log"))
+
+
+def _console_script() -> str:
+    return str(Path(sys.executable).with_name("ompl-balance"))
+
+
+def test_compare_interrupted_then_run_again_resumes(tmp_path):
+    out = tmp_path / "out"
+    command = [_console_script(), "compare", "--problems", "open", "--runs", "20", "-o", str(out), "--no-progress"]
+    compare = subprocess.Popen(
+        command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+    )
+    results = out / "results.jsonl"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and (not results.exists() or len(results.read_text().splitlines()) < 5):
+        time.sleep(0.05)
+    os.killpg(compare.pid, signal.SIGINT)  # Ctrl-C: the terminal signals the whole foreground group
+    _, stderr = compare.communicate(timeout=60)
+    assert compare.returncode == 130
+    assert f"the finished runs are kept in {out}; run the same command again to resume" in stderr
+    assert "Traceback" not in stderr
+    before = results.read_text().splitlines()
+    assert 5 <= len(before) < 60, "compare should have been interrupted mid-way"
+
+    finished = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
+    assert finished.returncode == 0, finished.stderr
+    assert "another definition" not in finished.stderr  # the same command, the same runs: resumed
+    after = [json.loads(line) for line in results.read_text().splitlines()]
+    keys = [(r["problem"], r["planner"], r["run"]) for r in after]
+    assert len(keys) == len(set(keys)) == 3 * 20
+    assert after[: len(before)] == [json.loads(line) for line in before]
+    assert f"60 runs in {out}" in finished.stdout
+
+
+DECOY = """\
+from pathlib import Path
+
+Path(__file__).resolve().parents[1].joinpath("DECOY_IMPORTED").write_text("a run imported this copy")
+"""
+
+
+def test_runs_import_the_installed_package_not_a_copy_in_the_current_folder(tmp_path):
+    (tmp_path / "ompl_balance").mkdir()
+    (tmp_path / "ompl_balance" / "__init__.py").write_text(DECOY)
+    (tmp_path / "experiment.toml").write_text(
+        'name = "decoy"\nruns = 2\ntime_limit = 5.0\n[[problems]]\nmbm = "box"\nids = [1]\n'
+        '[[problems]]\nbuiltin = "open"\n[[planners]]\nname = "BalancedRRTConnect"\n'
+    )
+    finished = subprocess.run(
+        [_console_script(), "bench", "experiment.toml", "-o", "out", "--no-progress"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert finished.returncode == 0, finished.stderr
+    assert not (tmp_path / "DECOY_IMPORTED").exists()
+    records = [json.loads(line) for line in (tmp_path / "out" / "results.jsonl").read_text().splitlines()]
+    assert len(records) == 4 and all(r["status"] == "EXACT_SOLUTION" for r in records)

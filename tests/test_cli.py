@@ -1,7 +1,12 @@
-"""The ompl-balance command line: compare runs and prints the table; bad options are refused."""
+"""The ompl-balance command line: compare runs and prints the table; bad options, missing extras
+and wrong folders end in one line saying what to do."""
+
+import json
+import sys
 
 import pytest
 
+from ompl_balance.bench.compare import compare_experiment
 from ompl_balance.cli import main
 
 
@@ -17,6 +22,20 @@ def test_compare_prints_a_table_per_problem(capsys):
         row.count("| 1.00 [1.00, 1.00] |") == 3 for row in stock_rows
     )  # time, checks, nodes: stock is the baseline
     assert all("| 2 | 100% |" in row for row in rows)
+    assert out.startswith("experiment seed 1\n")  # the default seed: the same command makes the same runs
+    assert "runs in a temporary folder, now deleted (-o OUT keeps" in out
+
+
+def test_compare_runs_motionbenchmaker_panda_problems_by_default(capsys):
+    from ompl_balance.cli import build_parser
+
+    defaults = build_parser().parse_args(["compare"]).problems
+    assert {"box.001", "bookshelf_small.001", "table_pick.001", "table_under_pick.001"} <= set(defaults)
+    assert main(["compare", "--runs", "1", "--problems", "box.001", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "### box.001" in out
+    rows = [line for line in out.splitlines() if line.startswith("| ") and "planner" not in line]
+    assert len(rows) == 3 and all("| 1 | 100% |" in row for row in rows)
 
 
 def test_compare_takes_stock_planners_and_presets_by_name(capsys):
@@ -41,7 +60,8 @@ def test_compare_takes_stock_planners_and_presets_by_name(capsys):
     [
         (["compare", "--runs", "0"], "must be a whole number >= 1"),
         (["compare", "--time-limit", "-1"], "positive number of seconds"),
-        (["compare", "--problems", "open,nowhere"], "unknown problem(s) nowhere"),
+        (["compare", "--problems", "open,nowhere"], "unknown problem 'nowhere'"),
+        (["compare", "--problems", "box.101"], "ids [101] not in the file"),
         (["compare", "--dask", "local:0"], "expected tcp://HOST:PORT or local:N"),
         (["compare", "--jobs", "0"], "must be a whole number >= 1"),
     ],
@@ -64,3 +84,30 @@ def test_gamma_prints_the_estimate_for_a_builtin_problem(capsys):
     assert float(lines["gamma*"]) == pytest.approx(expected, rel=1e-5)
     rewire_factor = next(line.split()[2] for line in out.splitlines() if line.startswith("OMPL rewire_factor"))
     assert float(rewire_factor) > 0
+
+
+def _one_line_error(capsys, args, expected):
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_dask_without_dask_is_one_line_naming_the_install(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # import fails as if not installed
+    _one_line_error(
+        capsys,
+        ["compare", "--problems", "open", "--runs", "1", "--dask", "local:1"],
+        "pip install 'ompl-balance[distributed]'",
+    )
+
+
+def test_plot_without_matplotlib_is_one_line_naming_the_install(monkeypatch, capsys, tmp_path):
+    (tmp_path / "experiment.json").write_text(json.dumps(compare_experiment(["open"], runs=1).as_dict()))
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    _one_line_error(capsys, ["plot", str(tmp_path)], "pip install 'ompl-balance[plot]'")
+
+
+def test_plot_of_a_folder_that_is_not_an_output_folder_is_one_line(capsys, tmp_path):
+    _one_line_error(capsys, ["plot", str(tmp_path / "nowhere")], "is not an output folder (no experiment.json)")
+    (tmp_path / "experiment.json").write_text("{not json")
+    _one_line_error(capsys, ["plot", str(tmp_path)], "cannot be read as an experiment")

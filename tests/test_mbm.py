@@ -108,3 +108,23 @@ def test_starts_and_goals_valid_with_vamp_panda(scenario):
     assert not bad_start and not no_goal, (
         f"{scenario}: invalid starts {bad_start}, problems without a valid goal {no_goal}"
     )
+
+
+def test_simple_setup_refuses_a_robot_with_another_joint_count(tmp_path):
+    from ompl_balance.collision.robots import load_panda_vamp
+
+    (problem,) = load_mbm(write(tmp_path))  # three joints
+    robot = load_panda_vamp()  # seven
+    with pytest.raises(ValueError, match=r"toy problem 7: its configurations have 3 joint values but robot .* has 7"):
+        problem.simple_setup(robot)
+
+
+def test_ompl_2d_resources_load_by_name_as_from_their_files():
+    from ompl_balance.worlds.ompl_2d import RESOURCES, load_circles, load_environment, load_queries
+
+    assert load_environment("env1") == load_environment(RESOURCES / "env1.txt")
+    assert load_environment("env1").width == 15
+    assert load_circles("circle_obstacles").circles == load_circles(RESOURCES / "circle_obstacles.txt").circles
+    assert load_queries("circle_queries") == load_queries(RESOURCES / "circle_queries.txt")
+    with pytest.raises(ValueError, match="neither a shipped resource"):
+        load_environment("env9")

@@ -27,7 +27,8 @@ from acceptance import (
     termination_test,
 )
 from ompl import util as ou
-from ompl_envs import RESOURCES, load_circles, load_environment, load_queries
+
+from ompl_balance.worlds.ompl_2d import RESOURCES, load_circles, load_environment, load_queries
 
 ou.setLogLevel(ou.LOG_ERROR)  # as TestPlanner's constructor
 

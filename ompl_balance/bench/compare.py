@@ -3,33 +3,43 @@
 :func:`bench` executes an :class:`~ompl_balance.bench.experiment.Experiment` (each run in its
 own process, see :mod:`ompl_balance.bench.runner`) and keeps everything in one folder::
 
-    OUT/experiment.json     the experiment (a later run of the same experiment resumes)
+    OUT/experiment.json     the experiment and the package versions its runs execute with
     OUT/results.jsonl       one record per finished run, appended as runs finish
-    OUT/logs/*.log          one OMPL benchmark log per problem (ompl_log.write_logs)
-    OUT/benchmark.db        the logs converted by OMPL's own converter
+    OUT/superseded.jsonl    runs recorded under an earlier definition of their cell (see resume)
+    OUT/logs/*.log          one OMPL benchmark log per problem (logs.write_logs)
+    OUT/benchmark.db        the logs converted by OMPL's own converter, with its views
     OUT/summary.md, .csv    medians, 95 % intervals, ratios to the baseline planner
 
-The logs, database and summary are rewritten from ``results.jsonl`` at the end of every
-sweep, interrupted or not.
+Running the same experiment into the folder again runs only what is missing; runs of a
+cell whose definition changed (parameters, problem, limits, seed, versions) run again
+(:mod:`ompl_balance.bench.resume`). The logs, database and summary are rewritten from the
+experiment's records at the end of every sweep, interrupted or not.
 """
 
 from __future__ import annotations
 
-import json
-import random
 import re
-from collections.abc import Sequence
+import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from tqdm import tqdm
 
 from ..worlds.boxes import PROBLEMS
-from .experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec
+from .experiment import Experiment, PlannerSpec, ProblemSpec, mbm_problems
 from .logs import to_database, write_logs
+from .resume import RESULTS_FILE, claim, experiment_records
 from .runner import Progress, Record, ResultStore, sweep
 from .summary import format_csv, format_markdown, summarize
 
 STOCK_LABEL = "RRTConnect"
+
+#: The experiment seed of ``compare`` unless ``--seed`` says otherwise (the same command
+#: makes the same runs, so running it again into its folder resumes).
+COMPARE_SEED = 1
+
+#: The MotionBenchMaker problems ``compare`` runs by default: problem 1 of each shipped Panda scenario.
+COMPARE_MBM_PROBLEMS = ("table_pick.001", "table_under_pick.001", "box.001", "bookshelf_small.001")
 
 
 def default_planners() -> list[PlannerSpec]:
@@ -59,42 +69,41 @@ def parse_planners(text: str) -> list[PlannerSpec]:
     return specs
 
 
-def compare_experiment(
-    problems: Sequence[str] = tuple(PROBLEMS),
-    planners: Sequence[PlannerSpec] | None = None,
-    runs: int = 20,
-    time_limit: float = 5.0,
-    seed: int | None = None,
-) -> Experiment:
-    """The ``ompl-balance compare`` experiment: built-in problems, stock RRTConnect as the baseline.
+def compare_problem(name: str) -> ProblemSpec:
+    """A problem of ``compare`` by name: a built-in 2-D problem (``narrow_gap``) or a shipped
+    MotionBenchMaker Panda problem ``<scenario>.<id>`` (``box.001``); ``ValueError`` otherwise."""
+    if name in PROBLEMS:
+        return ProblemSpec(name, "builtin", name)
+    from ..worlds.mbm import SCENARIOS
 
-    ``seed=None`` draws one (it is recorded in ``experiment.json`` and the logs).
-    """
-    planners = list(planners or default_planners())
-    return Experiment(
-        name="compare",
-        problems=tuple(ProblemSpec(name, "builtin", name) for name in problems),
-        planners=tuple(planners),
-        runs=runs,
-        time_limit=time_limit,
-        seed=random.randrange(1, 2**31 - 1) if seed is None else seed,
-        baseline=STOCK_LABEL if any(p.label == STOCK_LABEL for p in planners) else "",
+    scenario, _, number = name.rpartition(".")
+    if scenario in SCENARIOS and number.isdigit():
+        return mbm_problems(scenario, [int(number)])[0]
+    raise ValueError(
+        f"unknown problem {name!r}; built-in: {', '.join(PROBLEMS)}; or a MotionBenchMaker Panda problem "
+        f"<scenario>.<id> with scenario one of {', '.join(SCENARIOS)} (e.g. box.001)"
     )
 
 
-def _claim(out: Path, experiment: Experiment) -> None:
-    """Record ``experiment`` in ``out``; refuse a folder holding results of a different experiment."""
-    path = out / "experiment.json"
-    if path.exists() and (out / "results.jsonl").exists():
-        previous = Experiment.from_dict(json.loads(path.read_text()))
-        mine, theirs = experiment.results_identity(), previous.results_identity()
-        differing = sorted(key for key in mine if mine[key] != theirs.get(key))
-        if differing:
-            raise ExperimentError(
-                str(out), f"holds results of an experiment with other {', '.join(differing)}; use another output folder"
-            )
-    out.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(experiment.as_dict(), indent=1))
+def compare_experiment(
+    problems: Sequence[str] = (*PROBLEMS, *COMPARE_MBM_PROBLEMS),
+    planners: Sequence[PlannerSpec] | None = None,
+    runs: int = 20,
+    time_limit: float = 5.0,
+    seed: int = COMPARE_SEED,
+) -> Experiment:
+    """The ``ompl-balance compare`` experiment: the built-in 2-D problems and problem 1 of each
+    MotionBenchMaker Panda scenario, stock RRTConnect as the baseline."""
+    planners = list(planners or default_planners())
+    return Experiment(
+        name="compare",
+        problems=tuple(compare_problem(name) for name in problems),
+        planners=tuple(planners),
+        runs=runs,
+        time_limit=time_limit,
+        seed=seed,
+        baseline=STOCK_LABEL if any(p.label == STOCK_LABEL for p in planners) else "",
+    )
 
 
 def write_outputs(experiment: Experiment, records: Sequence[Record], out: Path) -> str:
@@ -109,27 +118,33 @@ def write_outputs(experiment: Experiment, records: Sequence[Record], out: Path) 
     return table
 
 
-def experiment_records(experiment: Experiment, store: ResultStore) -> list[Record]:
-    """The records in ``store`` that belong to ``experiment`` (its problems, planners and run indices)."""
-    keys = {task.key for task in experiment.tasks()}
-    return [r for r in store.records() if (r["problem"], r["planner"], r["run"]) in keys]
+def _to_stderr(message: str) -> None:
+    print(message, file=sys.stderr)
 
 
 def bench(
-    experiment: Experiment, out: str | Path, jobs: int = 1, dask: str | None = None, progress: bool = True
+    experiment: Experiment,
+    out: str | Path,
+    jobs: int = 1,
+    dask: str | None = None,
+    progress: bool = True,
+    notify: Callable[[str], None] = _to_stderr,
 ) -> list[Record]:
     """Run what is missing of ``experiment`` into ``out`` and write the logs, database and summary.
 
-    ``jobs`` runs at a time on this machine, or on the Dask cluster ``dask``. Returns
-    the experiment's records (all of them, earlier sweeps' included).
+    ``jobs`` runs at a time on this machine, or on the Dask cluster ``dask``. Runs the
+    folder holds under another definition of their cell are superseded and run again;
+    ``notify`` receives the notice saying so. Returns the experiment's records (all of
+    them, earlier sweeps' included).
     """
     out = Path(out)
-    _claim(out, experiment)
-    store = ResultStore(out / "results.jsonl")
-    total = len(experiment.tasks())
+    claimed = claim(out, experiment)
+    if claimed.superseded:
+        notify(claimed.message(out))
+    store = ResultStore(out / RESULTS_FILE)
     bar = tqdm(
-        total=total,
-        initial=len(experiment_records(experiment, store)),
+        total=len(experiment.tasks()),
+        initial=claimed.kept,
         disable=not progress,
         unit="run",
         smoothing=0.1,

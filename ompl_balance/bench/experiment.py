@@ -7,7 +7,7 @@ Experiments come from TOML files (:func:`load_experiment`) or from Python::
     name = "narrow"            # no spaces; names the OMPL logs
     runs = 5                   # runs per (problem, planner) cell
     time_limit = 1.0           # seconds of planning per run
-    memory_limit = 0           # MB per run process, 0 = no limit
+    memory_limit = 0           # MB a run may add to its memory (as OMPL), 0 = no limit
     seed = 1                   # decides every run's seed (see run_seed)
     baseline = "RRTConnect"    # planner label the summary's ratios refer to
 
@@ -47,10 +47,12 @@ from __future__ import annotations
 
 import hashlib
 import importlib
+import json
 import re
 import sys
-from collections.abc import Callable, Mapping
-from dataclasses import asdict, dataclass, field
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict, dataclass, field, fields
+from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -61,6 +63,7 @@ from ..core.counting import ensure_counting
 from ..planners import PRESETS
 from ..rrtstar import BallRadiusRRTstar
 from ..worlds.boxes import PROBLEMS
+from .planner_params import DECLARED_PARAMS, check_declared_param, set_planner_param
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -80,6 +83,10 @@ class ExperimentError(ValueError):
         self.key, self.value = key, value
 
 
+class MissingExtraError(ImportError):
+    """An optional dependency is not installed; the message names the ``pip install`` that adds it."""
+
+
 # -- planners ---------------------------------------------------------------------------
 
 
@@ -91,73 +98,6 @@ def package_planner_classes() -> dict[str, type[ob.Planner]]:
 def stock_planner_classes() -> dict[str, type[ob.Planner]]:
     """OMPL's geometric planners bound in ``ompl.geometric`` (``RRTConnect``, ``RRT``, ``PRM``, ...)."""
     return {name: cls for name, cls in vars(og).items() if isinstance(cls, type) and issubclass(cls, ob.Planner)}
-
-
-def _camel(name: str) -> str:
-    return "".join(part[:1].upper() + part[1:] for part in name.split("_"))
-
-
-def _snake(camel: str) -> str:
-    return re.sub(r"(?<!^)(?=[A-Z])", "_", camel).lower()
-
-
-def _convert_like(current: Any, text: str) -> Any:
-    """``text`` (OMPL string form) as a value of ``current``'s type."""
-    if isinstance(current, bool):
-        lowered = text.strip().lower()
-        if lowered not in ("0", "1", "true", "false"):
-            raise ValueError("expected one of 0, 1, true, false")
-        return lowered in ("1", "true")
-    return type(current)(text)
-
-
-def _param_set(planner: ob.Planner):
-    """The planner's ``ParamSet`` when it has a usable one (this package's planners), else ``None``.
-
-    OMPL 2.0's ``Planner.params()`` raises ``TypeError`` from Python (not bound).
-    """
-    try:
-        return planner.params()
-    except TypeError:
-        return None
-
-
-def set_planner_param(planner: ob.Planner, name: str, value: str) -> None:
-    """Set parameter ``name`` to ``value`` (OMPL string form); ``ValueError`` naming what is accepted.
-
-    This package's planners go through ``planner.params()``; stock OMPL planners (whose
-    ``params()`` is not bound in Python) through their ``set<Name>`` method, the value
-    converted to the type ``get<Name>`` returns.
-    """
-    params = _param_set(planner)
-    if params is not None:
-        if not params.hasParam(name):
-            raise ValueError(f"unknown parameter {name!r}; {planner.getName()} has {', '.join(params.getParamNames())}")
-        if not params.setParam(name, value):
-            raise ValueError(f"bad value {value!r} for {name!r}; accepted: {params.getRangeSuggestion(name)}")
-        return
-    setter, getter = getattr(planner, "set" + _camel(name), None), getattr(planner, "get" + _camel(name), None)
-    if setter is None or getter is None:
-        raise ValueError(f"unknown parameter {name!r}; {planner.getName()} has {', '.join(planner_params(planner))}")
-    setter(_convert_like(getter(), value))
-
-
-def planner_params(planner: ob.Planner) -> dict[str, str]:
-    """The planner's parameters as OMPL strings: ``params().getParams()`` for this package's
-    planners, the ``get<Name>``/``set<Name>`` pairs with scalar values for stock ones."""
-    params = _param_set(planner)
-    if params is not None:
-        return dict(params.getParams())
-    values = {}
-    for attribute in dir(planner):
-        if attribute.startswith("get") and attribute != "getName" and hasattr(planner, "set" + attribute[3:]):
-            try:
-                value = getattr(planner, attribute)()
-            except TypeError:  # a getter that needs arguments is not a parameter
-                continue
-            if isinstance(value, (bool, int, float, str)):
-                values[_snake(attribute[3:])] = str(int(value)) if isinstance(value, bool) else str(value)
-    return values
 
 
 def _param_text(value: Any) -> str:
@@ -222,6 +162,13 @@ class PlannerSpec:
             raise ExperimentError(
                 "name", f"unknown planner {self.name!r}; known: {', '.join(sorted(known))}", self.name
             )
+        if self.name in DECLARED_PARAMS:  # a stock planner: checked against OMPL's names, not built
+            for name, value in self.params.items():
+                try:
+                    check_declared_param(self.name, name, value)
+                except ValueError as error:
+                    raise ExperimentError(f"params.{name}", str(error)) from error
+            return
         space = ob.RealVectorStateSpace(2)
         space.setBounds(0.0, 1.0)
         si = ob.SpaceInformation(space)
@@ -243,9 +190,11 @@ class ProblemSpec:
 
     ``kind`` is ``"builtin"`` (``source`` names one of ``ompl_balance.worlds.boxes.PROBLEMS``),
     ``"mbm"`` (``source`` is a shipped MotionBenchMaker scenario or a JSON file,
-    ``problem_id`` the problem's id and ``robot`` the robot folder, empty for the shipped Panda) or ``"factory"`` (``source`` is
-    ``"module:function"`` called with ``args``). ``name`` is unique in the experiment
-    and names its log file.
+    ``problem_id`` the problem's id and ``robot`` the robot folder, empty for the shipped
+    Panda) or ``"factory"`` (``source`` is ``"module:function"`` called with ``args``).
+    ``name`` is unique in the experiment and names its log file. ``data`` is a digest of
+    the files a MotionBenchMaker problem is read from when they are not shipped with the
+    package (:func:`mbm_problems` fills it), so that an edited file makes a new problem.
     """
 
     name: str
@@ -254,13 +203,16 @@ class ProblemSpec:
     problem_id: int = 0
     robot: str = ""
     args: Mapping[str, Any] = field(default_factory=dict)
+    data: str = ""
 
     def build(self) -> og.SimpleSetup:
         """A fresh ``SimpleSetup`` with start, goal and a counting validity checker."""
         if self.kind == "builtin":
             ss = PROBLEMS[self.source].setup()
         elif self.kind == "mbm":
-            ss = _mbm_setup(self.source, self.problem_id, self.robot)
+            from ..worlds.mbm import problem_setup
+
+            ss = problem_setup(self.source, self.problem_id, self.robot)
         else:
             ss = _import_function(self.source)(**self.args)
             if not isinstance(ss, og.SimpleSetup):
@@ -268,20 +220,31 @@ class ProblemSpec:
         ensure_counting(ss.getSpaceInformation())
         return ss
 
-    @property
-    def dimension(self) -> int:
-        """2 for the built-in worlds, 0 when unknown without building."""
-        return 2 if self.kind == "builtin" else 0
 
-
-def _mbm_setup(path: str, problem_id: int, robot_dir: str) -> og.SimpleSetup:
-    """A MotionBenchMaker problem on VAMP's Panda layout: batched checker, all goals as ``GoalStates``."""
-    from ..collision.robots import load_panda_vamp
+def mbm_problems(scenario: str, ids: Sequence[int] | None = None, robot: str = "") -> list[ProblemSpec]:
+    """Specs of MotionBenchMaker problems, named ``<scenario>.NNN``: a shipped scenario by name or
+    a JSON file (absolute path), ``ids`` (default: all), ``robot`` a folder with ``panda.urdf``
+    and ``panda.srdf`` (default: the shipped Panda). ``ValueError`` for what cannot be read."""
     from ..worlds.mbm import load_mbm
 
-    robot = load_panda_vamp(robot_dir or None)
-    problem = next(p for p in load_mbm(path, robot.joint_names) if p.id == problem_id)
-    return problem.simple_setup(robot)
+    problems = load_mbm(scenario)
+    available = [problem.id for problem in problems]
+    missing = sorted(set(ids or ()) - set(available))
+    if missing:
+        raise ValueError(f"ids {missing} not in the file (it has {min(available)}..{max(available)})")
+    name = problems[0].scenario if problems else Path(scenario).stem
+    return _mbm_specs(name, scenario, available if ids is None else list(ids), robot)
+
+
+def _mbm_specs(name: str, source: str, ids: Sequence[int], robot: str) -> list[ProblemSpec]:
+    """Specs of the problems ``ids`` of a scenario, with the digest of its files unless shipped."""
+    from ..worlds.mbm import SCENARIOS, files_digest
+
+    files = [] if source in SCENARIOS else [Path(source)]
+    if robot:
+        files += [Path(robot) / "panda.urdf", Path(robot) / "panda.srdf"]
+    data = files_digest(files) if files else ""
+    return [ProblemSpec(f"{name}.{i:03d}", "mbm", source, problem_id=i, robot=robot, data=data) for i in ids]
 
 
 # -- the experiment ---------------------------------------------------------------------
@@ -297,6 +260,17 @@ def run_seed(experiment_seed: int, problem: str, planner: str, run: int) -> int:
     return 1 + int.from_bytes(digest, "little") % (2**31 - 2)
 
 
+def versions() -> dict[str, str]:
+    """The versions of this package and of OMPL's Python package that runs execute with."""
+    return {"ompl-balance": metadata.version("ompl-balance"), "ompl": metadata.version("ompl")}
+
+
+def digest(definition: Mapping[str, Any]) -> str:
+    """A short stable hash of a JSON-able definition."""
+    text = json.dumps(definition, sort_keys=True, default=str)
+    return hashlib.blake2b(text.encode(), digest_size=8).hexdigest()
+
+
 @dataclass(frozen=True)
 class RunTask:
     """One run: everything a worker process needs to execute it."""
@@ -306,8 +280,9 @@ class RunTask:
     run: int  # 0-based index within its cell
     seed: int
     time_limit: float  # s of planning (and again at most as much for simplification)
-    memory_limit: float  # MB for the run's process, 0 = no limit
+    memory_limit: float  # MB the run may add to its process's memory (runner.MemoryLimit), 0 = no limit
     hard_limit: float  # s of wall clock after which the run's process is killed
+    definition: str = ""  # digest of the cell's definition (Experiment.cell_definition)
 
     @property
     def key(self) -> tuple[str, str, int]:
@@ -315,6 +290,9 @@ class RunTask:
 
 
 HARD_LIMIT_MARGIN = 5.0  # s added to 2 x the time limit before a run is killed
+
+#: The experiment's fields that define every run's result (besides its problem and planner).
+RUN_DEFINING_FIELDS = ("seed", "time_limit", "memory_limit", "hard_limit_margin")
 
 
 @dataclass(frozen=True)
@@ -334,8 +312,24 @@ class Experiment:
     def __post_init__(self) -> None:
         check_experiment(self)
 
+    def cell_definition(self, problem: ProblemSpec, planner: PlannerSpec) -> dict[str, Any]:
+        """Everything that defines the results of a (problem, planner) cell: both specs, the
+        seed and limits, and the versions of this package and OMPL. A finished run counts
+        for this experiment only when it was recorded under the same definition."""
+        return {
+            "problem": asdict(problem),
+            "planner": asdict(planner),
+            **{key: getattr(self, key) for key in RUN_DEFINING_FIELDS},
+            "versions": versions(),
+        }
+
     def tasks(self) -> list[RunTask]:
         """All runs, interleaved (run 0 of every cell, then run 1, ...) so slow phases of the machine hit all alike."""
+        definitions = {
+            (problem.name, planner.label): digest(self.cell_definition(problem, planner))
+            for problem in self.problems
+            for planner in self.planners
+        }
         return [
             RunTask(
                 problem,
@@ -345,6 +339,7 @@ class Experiment:
                 self.time_limit,
                 self.memory_limit,
                 2 * self.time_limit + self.hard_limit_margin,
+                definitions[problem.name, planner.label],
             )
             for run in range(self.runs)
             for problem in self.problems
@@ -360,19 +355,11 @@ class Experiment:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Experiment:
-        """Inverse of :meth:`as_dict` (e.g. from ``experiment.json`` in an output folder)."""
-        values = dict(data)
+        """Inverse of :meth:`as_dict` (e.g. from ``experiment.json`` in an output folder; other keys are ignored)."""
+        values = {key: data[key] for key in (f.name for f in fields(cls)) if key in data}
         values["problems"] = tuple(ProblemSpec(**p) for p in data["problems"])
         values["planners"] = tuple(PlannerSpec(**p) for p in data["planners"])
         return cls(**values)
-
-    def results_identity(self) -> dict[str, Any]:
-        """What decides a run's result (everything but the number of runs and the baseline):
-        finished runs may be reused only by an experiment with the same identity."""
-        identity = self.as_dict()
-        for key in ("runs", "baseline", "hard_limit_margin", "problems", "planners"):
-            identity.pop(key)
-        return identity
 
 
 def check_experiment(experiment: Experiment) -> None:
@@ -545,16 +532,16 @@ def _mbm_problems(table: Mapping[str, Any], where: str, base_dir: Path) -> list[
     robot = ""  # the Panda shipped with the package
     if "robot" in table:
         robot = str((base_dir / table["robot"]).resolve())
-        if not (Path(robot) / "panda.urdf").is_file():
-            raise ExperimentError(f"{where}.robot", f"no panda.urdf in {robot!r}", table["robot"])
+        missing = [name for name in ("panda.urdf", "panda.srdf") if not (Path(robot) / name).is_file()]
+        if missing:
+            raise ExperimentError(f"{where}.robot", f"no {' or '.join(missing)} in {robot!r}", table["robot"])
     try:
         scenario = load_mbm(source)
     except ValueError as error:
         raise ExperimentError(f"{where}.mbm", str(error), table["mbm"]) from error
-    available = [problem.id for problem in scenario]
-    ids = _ids(table.get("ids", "all"), available, f"{where}.ids")
+    ids = _ids(table.get("ids", "all"), [problem.id for problem in scenario], f"{where}.ids")
     name = scenario[0].scenario if scenario else Path(source).stem
-    return [ProblemSpec(f"{name}.{i:03d}", "mbm", source, problem_id=i, robot=robot) for i in ids]
+    return _mbm_specs(name, source, ids, robot)
 
 
 def _ids(selection: Any, available: list[int], where: str) -> list[int]:

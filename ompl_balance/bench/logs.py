@@ -5,13 +5,16 @@
 header, the ``status`` enum, then per planner its parameters as *common properties*
 (``name = value``), the sorted union of the run properties (``"time REAL"``,
 ``"validity checks INTEGER"``, ...) and one ``value; value; ...; `` line per run (empty
-where a run lacks a property, e.g. tree sizes of a crashed run). Unlike a stock
-``ompl.tools.Benchmark`` log made from Python, the parameters and counters of this
-package's planners are in it.
+where a run lacks a property, e.g. tree sizes of a crashed run), and, for a planner with
+progress properties, the progress section: ``N progress properties for each run``, their
+names (``"time REAL"`` among them, sorted), ``R runs`` and per run one line of samples,
+each ``value,value,...,`` followed by ``;``. Unlike a stock ``ompl.tools.Benchmark`` log
+made from Python, the parameters, counters and progress of this package's planners are in it.
 
 :func:`to_database` converts logs with the converter that ships with the ``ompl``
-package (``ompl_benchmark_statistics``, i.e. ``ompl.tools.readBenchmarkLog``), so the
-database is the one Planner Arena and OMPL's plotting scripts read.
+package (``ompl.tools.readBenchmarkLog``) and adds its views (``computeViews``), exactly
+as ``ompl_benchmark_statistics logs/*.log -d benchmark.db`` does, so the database is the
+one Planner Arena and OMPL's plotting scripts read.
 """
 
 from __future__ import annotations
@@ -34,11 +37,11 @@ from .runner import STATUS_INDEX, Record
 
 def _status_enum_line() -> str:
     members = ob.PlannerStatus.PlannerStatusType.__members__
-    names = [ob.PlannerStatus(members[name]).asString() for name in sorted(STATUS_INDEX, key=STATUS_INDEX.get)]
+    names = [ob.PlannerStatus(members[name]).asString() for name in sorted(STATUS_INDEX, key=STATUS_INDEX.__getitem__)]
     return "status|" + "|".join(names)
 
 
-def _value(value) -> str:
+def _value(value: object) -> str:
     text = repr(value) if isinstance(value, float) else str(value)
     if "; " in text or "\n" in text:
         raise ValueError(f"a run property value may not contain '; ' or a newline: {text!r}")
@@ -49,11 +52,21 @@ def format_log(experiment: Experiment, problem: str, records: Sequence[Record], 
     """The OMPL log text of ``problem``: its records, grouped by planner in the experiment's order."""
     planners = [p for p in experiment.planners if any(r["planner"] == p.label for r in records)]
     spec = next(p for p in experiment.problems if p.name == problem)
+    named_by_getters = {r["planner"] for r in records if r.get("param_names") == "getters"}
     setup = (
         f"problem {problem}: {spec.kind} {spec.source}"
         + (f" id {spec.problem_id}" if spec.kind == "mbm" else "")
         + "\n"
-        + "".join(f"planner {p.label}: {p.name or p.factory} {dict(p.params)}\n" for p in planners)
+        + "".join(
+            f"planner {p.label}: {p.name or p.factory} {dict(p.params)}"
+            + (
+                " (parameters named after its get/set methods: OMPL's declared names are not known)"
+                if p.label in named_by_getters
+                else ""
+            )
+            + "\n"
+            for p in planners
+        )
     )
     lines = [
         f"OMPL version {metadata.version('ompl')}",
@@ -84,8 +97,38 @@ def format_log(experiment: Experiment, problem: str, records: Sequence[Record], 
         for run in runs:
             values = {**run["properties"], "seed INTEGER": run["seed"]}
             lines.append("".join(f"{_value(values[name]) if name in values else ''}; " for name in properties))
+        lines += _progress_section(runs)
         lines.append(".")
     return "\n".join(lines) + "\n"
+
+
+def _progress_section(runs: Sequence[Record]) -> list[str]:
+    """The progress lines of a planner's runs (none when no run reports progress).
+
+    Every run has its line, in the order of the run lines (OMPL's converter pairs them by
+    position); a run without samples (it ended within the first period, or crashed) has
+    an empty one.
+    """
+    if not any("progress" in run for run in runs):
+        return []
+    names = sorted({name for run in runs for name in run.get("progress", {}).get("properties", ())})
+    lines = [f"{len(names)} progress properties for each run", *names, f"{len(runs)} runs"]
+    for run in runs:
+        progress = run.get("progress", {"properties": [], "samples": []})
+        column = {name: i for i, name in enumerate(progress["properties"])}
+        lines.append(
+            "".join(
+                "".join(f"{_progress_value(sample[column[n]]) if n in column else ''}," for n in names) + ";"
+                for sample in progress["samples"]
+            )
+        )
+    return lines
+
+
+def _progress_value(text: str) -> str:
+    if "," in text or ";" in text or "\n" in text:
+        raise ValueError(f"a progress value may not contain ',', ';' or a newline: {text!r}")
+    return text
 
 
 def write_logs(experiment: Experiment, records: Iterable[Record], folder: str | Path) -> list[Path]:
@@ -104,9 +147,11 @@ def write_logs(experiment: Experiment, records: Iterable[Record], folder: str | 
 
 
 def to_database(logs: Sequence[str | Path], database: str | Path) -> Path:
-    """Convert OMPL logs to a fresh SQLite database with OMPL's own converter; returns its path."""
+    """Convert OMPL logs to a fresh SQLite database with OMPL's own converter and views
+    (``bestPlannerConfigs``, ``bestPlannerConfigsPerExperiment``); returns its path."""
     database = Path(database)
     database.unlink(missing_ok=True)
     with contextlib.redirect_stdout(io.StringIO()):  # the converter prints a line per log and planner
         ot.readBenchmarkLog(str(database), [str(log) for log in logs], False)
+    ot.computeViews(str(database), False)
     return database

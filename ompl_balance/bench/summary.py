@@ -53,19 +53,19 @@ def measure(
 
     The baseline's own ratio is exactly 1 (``is_baseline``); no baseline runs give a NaN ratio.
     """
-    values, baseline = np.asarray(values, float), np.asarray(baseline, float)
-    if len(values) == 0:
+    mine, base = np.asarray(values, float), np.asarray(baseline, float)
+    if len(mine) == 0:
         return NAN_MEASURE
-    samples = _bootstrap_medians(values, rng)
-    median = float(np.median(values))
+    samples = _bootstrap_medians(mine, rng)
+    median = float(np.median(mine))
     if is_baseline:
         return Measure(median, _interval(samples), 1.0, (1.0, 1.0))
-    if len(baseline) == 0 or np.median(baseline) <= 0:
+    if len(base) == 0 or np.median(base) <= 0:
         return Measure(median, _interval(samples), math.nan, (math.nan, math.nan))
-    base_samples = _bootstrap_medians(baseline, rng)
+    base_samples = _bootstrap_medians(base, rng)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratios = samples / base_samples
-    return Measure(median, _interval(samples), median / float(np.median(baseline)), _interval(ratios))
+    return Measure(median, _interval(samples), median / float(np.median(base)), _interval(ratios))
 
 
 @dataclass(frozen=True)

@@ -11,10 +11,14 @@ The package ships four scenarios of MotionBenchMaker's Panda set, 100 problems e
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from ompl import base as ob
@@ -55,7 +59,18 @@ class MBMProblem:
     def simple_setup(self, robot: RobotModel, checker: CollisionChecker | None = None) -> og.SimpleSetup:
         """A ``SimpleSetup`` for this problem: ``robot``'s joint space, the package's checker
         and motion validator (``checker``, or a new one for this environment), the start,
-        and every goal as ``ob.GoalStates`` (any goal is a success)."""
+        and every goal as ``ob.GoalStates`` (any goal is a success).
+
+        ``ValueError`` when ``robot`` has another number of joints than the problem's
+        configurations (load the problems with ``load_mbm(scenario, robot.joint_names)``:
+        it reorders them to the robot's joints and refuses joints the two do not share).
+        """
+        if robot.dof != len(self.start):
+            raise ValueError(
+                f"MotionBenchMaker {self.scenario} problem {self.id}: its configurations have {len(self.start)} joint "
+                f"values but robot {robot.name!r} has {robot.dof} joints ({', '.join(robot.joint_names)}); load the "
+                "problems with load_mbm(scenario, robot.joint_names) for the robot they were made for"
+            )
         ss = og.SimpleSetup(space_for(robot))
         setup_robot(ss, checker or CollisionChecker(robot, self.environment))
         si = ss.getSpaceInformation()
@@ -100,20 +115,20 @@ def load_mbm(scenario: str | Path, joint_names: list[str] | None = None) -> list
     ]
 
 
-def _field(record, name: str, where):
+def _field(record: Any, name: str, where: object) -> Any:
     if not isinstance(record, dict) or name not in record:
         raise ValueError(f"{where}: missing field {name!r}")
     return record[name]
 
 
-def _configurations(values, width: int, where: str) -> np.ndarray:
+def _configurations(values: Any, width: int, where: str) -> np.ndarray:
     array = np.asarray(values, dtype=float)
     if array.ndim != 2 or array.shape[1] != width or not np.all(np.isfinite(array)):
         raise ValueError(f"{where}: expected finite configurations of {width} joint values, got {values!r}")
     return array
 
 
-def _problem(record, scenario: str, column: list[int], where: str) -> MBMProblem:
+def _problem(record: Any, scenario: str, column: list[int], where: str) -> MBMProblem:
     start = _configurations([_field(record, "start", where)], len(column), f"{where} start")[0, column]
     goals = _configurations(_field(record, "goals", where), len(column), f"{where} goals")[:, column]
     environment = Environment()
@@ -136,3 +151,46 @@ def _problem(record, scenario: str, column: list[int], where: str) -> MBMProblem
     return MBMProblem(
         scenario, int(_field(record, "id", where)), start, goals, environment, bool(record.get("valid", True))
     )
+
+
+# -- problems of benchmark runs -------------------------------------------------------
+
+
+@functools.lru_cache(maxsize=4)
+def _robot(robot_dir: str) -> RobotModel:
+    """The robot of a folder (``""``: the Panda shipped with the package), loaded once per process."""
+    from ..collision.robots import load_panda_vamp
+
+    return load_panda_vamp(robot_dir or None)
+
+
+@functools.lru_cache(maxsize=16)
+def _scenario(source: str, robot_dir: str) -> dict[int, MBMProblem]:
+    """A scenario's problems by id, joints ordered as the robot's; loaded once per process."""
+    return {problem.id: problem for problem in load_mbm(source, _robot(robot_dir).joint_names)}
+
+
+def problem_setup(source: str, problem_id: int, robot_dir: str = "") -> og.SimpleSetup:
+    """The ``SimpleSetup`` of problem ``problem_id`` of scenario ``source`` (a shipped name or a
+    file) for the robot in ``robot_dir`` (``""``: the shipped Panda). Robot and scenario are read
+    once per process."""
+    return _scenario(source, robot_dir)[problem_id].simple_setup(_robot(robot_dir))
+
+
+def load_shipped_data() -> None:
+    """Read the shipped Panda and scenarios into the caches of :func:`problem_setup`.
+
+    The forkserver of a benchmark sweep with MotionBenchMaker problems calls this (by
+    importing :mod:`ompl_balance.bench.preload_mbm`), so every run's process, forked from
+    it, starts with them instead of reading them again (~0.1 s a run).
+    """
+    for scenario in SCENARIOS:
+        _scenario(scenario, "")
+
+
+def files_digest(paths: Sequence[Path]) -> str:
+    """A short hash of the files' contents (a problem read from them changes when they do)."""
+    digest = hashlib.blake2b(digest_size=8)
+    for path in paths:
+        digest.update(path.read_bytes())
+    return digest.hexdigest()

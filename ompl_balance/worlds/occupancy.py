@@ -14,7 +14,7 @@ R^2 (``"rooms"``) or SE(2) (``"rooms_se2"``, a point robot with a free heading).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from ompl import base as ob
@@ -28,6 +28,7 @@ class OccupancyGrid:
     occupied: np.ndarray
     resolution: float
     origin: tuple[float, float] = (0.0, 0.0)
+    _free_rows: list[list[bool]] = field(init=False, repr=False)  # list lookups: fastest per-state check
 
     def __post_init__(self) -> None:
         occupied = np.asarray(self.occupied)
@@ -38,7 +39,7 @@ class OccupancyGrid:
         if not math.isfinite(self.resolution) or self.resolution <= 0:
             raise ValueError(f"resolution must be a positive cell side in metres, got {self.resolution!r}")
         object.__setattr__(self, "occupied", occupied)
-        object.__setattr__(self, "_free_rows", (~occupied).tolist())  # list lookups: fastest per-state check
+        object.__setattr__(self, "_free_rows", (~occupied).tolist())
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -142,10 +143,13 @@ def rooms_grid(side: float = 40.0, resolution: float = 0.2) -> OccupancyGrid:
         occupied[cell(y0) : cell(y1), cell(x0) : cell(x1)] = value
 
     wall = 0.2
-    fill(0, 0, 10, wall), fill(0, 10 - wall, 10, 10), fill(0, 0, wall, 10), fill(10 - wall, 0, 10, 10)
-    fill(0, 4.5 - wall, 10, 4.5), fill(0, 5.5, 10, 5.5 + wall)  # corridor walls
+    for box in ((0, 0, 10, wall), (0, 10 - wall, 10, 10), (0, 0, wall, 10), (10 - wall, 0, 10, 10)):
+        fill(*box)
+    fill(0, 4.5 - wall, 10, 4.5)  # corridor walls
+    fill(0, 5.5, 10, 5.5 + wall)
     for x in (10 / 3, 20 / 3):  # walls between rooms, below and above the corridor
-        fill(x - wall / 2, 0, x + wall / 2, 4.5), fill(x - wall / 2, 5.5, x + wall / 2, 10)
+        fill(x - wall / 2, 0, x + wall / 2, 4.5)
+        fill(x - wall / 2, 5.5, x + wall / 2, 10)
     door = 0.8
     for x in (2.6, 4.2, 8.8):  # doors from the lower rooms into the corridor
         fill(x, 4.5 - wall, x + door, 4.5, False)

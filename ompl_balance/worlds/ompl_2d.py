@@ -4,7 +4,11 @@ Python versions of ``tests/resources/environment2D.h`` (occupancy grid),
 ``tests/resources/circles2D.h`` (circular obstacles and queries),
 ``tests/geometric/2d/2DmapSetup.h`` and ``tests/geometric/2d/2DcirclesSetup.h``
 (the space information OMPL's ``2denvs.cpp`` plans in), reading the resource files
-the package ships (``ompl_balance/data/ompl_2d/``, byte copies of OMPL's).
+the package ships (``ompl_balance/data/ompl_2d/``, byte copies of OMPL's), by name::
+
+    env = load_environment("env1")                  # or a path to a file of the same format
+    circles = load_circles("circle_obstacles")
+    queries = load_queries("circle_queries")
 
 Validity rules are OMPL's: a map state is valid when the grid cell it falls in
 (coordinates rounded towards zero) exists and is free (0); a circles state is valid
@@ -25,10 +29,24 @@ from pathlib import Path
 
 from ompl import base as ob
 
-from ompl_balance import CountingValidityChecker
+from ..core.counting import CountingValidityChecker
 
 #: Where the resource files live: shipped with the package.
 RESOURCES = Path(str(resources.files("ompl_balance") / "data" / "ompl_2d"))
+#: The shipped resources by name.
+RESOURCE_NAMES = ("env1", "env2", "circle_obstacles", "circle_queries")
+
+
+def resource_path(name: str | Path) -> Path:
+    """The file of a shipped resource (``"env1"`` or ``"env1.txt"``), or ``name`` itself as a path."""
+    stem = str(name).removesuffix(".txt")
+    if stem in RESOURCE_NAMES and not Path(name).is_file():
+        return RESOURCES / f"{stem}.txt"
+    path = Path(name)
+    if not path.is_file():
+        raise ValueError(f"{str(name)!r} is neither a shipped resource ({', '.join(RESOURCE_NAMES)}) nor a file")
+    return path
+
 
 T_FREE = 0  # the free grid cell value of environment2D.h
 
@@ -68,13 +86,14 @@ class Environment2D:
         return self.is_free(state[0], state[1])
 
 
-def load_environment(path: Path) -> Environment2D:
-    """Read an ``env*.txt`` occupancy grid (``loadEnvironment`` of environment2D.h).
+def load_environment(path: str | Path) -> Environment2D:
+    """Read an ``env*.txt`` occupancy grid (``loadEnvironment`` of environment2D.h), shipped or a file.
 
     The file is a stream of ``discretization(cells): W H``, ``start(cells): X Y``,
     ``end(cells): X Y`` and ``environment:`` followed by ``W x H`` cell values.
     """
-    tokens = iter(Path(path).read_text().split())
+    path = resource_path(path)
+    tokens = iter(path.read_text().split())
     width = height = 0
     start = goal = (0, 0)
     cells: list[int] = []
@@ -180,13 +199,14 @@ class Circles2D:
         return self.no_overlap(state[0], state[1])
 
 
-def load_circles(path: Path) -> Circles2D:
-    """Read ``circle_obstacles.txt``: two header lines, then ``id x y r`` per circle.
+def load_circles(path: str | Path) -> Circles2D:
+    """Read ``circle_obstacles.txt`` (shipped, or a file): two header lines, then ``id x y r`` per circle.
 
     As ``Circles2D::loadCircles``, reading stops at the first record that does not parse.
     """
+    path = resource_path(path)
     circles = []
-    for line in Path(path).read_text().splitlines()[2:]:
+    for line in path.read_text().splitlines()[2:]:
         fields = line.split()
         try:
             _, x, y, r = int(fields[0]), float(fields[1]), float(fields[2]), float(fields[3])
@@ -198,9 +218,10 @@ def load_circles(path: Path) -> Circles2D:
     return Circles2D(circles)
 
 
-def load_queries(path: Path) -> list[CircleQuery]:
-    """Read ``circle_queries.txt``: per query ``N start: x y`` then ``N goal: x y``."""
-    tokens = Path(path).read_text().split()
+def load_queries(path: str | Path) -> list[CircleQuery]:
+    """Read ``circle_queries.txt`` (shipped, or a file): per query ``N start: x y`` then ``N goal: x y``."""
+    path = resource_path(path)
+    tokens = path.read_text().split()
     if len(tokens) % 8:
         raise ValueError(f"{path}: expected records 'N start: x y N goal: x y', got {len(tokens)} tokens")
     try:

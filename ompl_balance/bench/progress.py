@@ -1,0 +1,125 @@
+"""Planner progress sampled while a run solves, as ``ompl.tools.Benchmark`` samples it.
+
+OMPL's Benchmark starts a thread next to ``solve`` that, every ``timeBetweenUpdates``
+seconds (0.05 by default), reads each of the planner's progress properties
+(``getPlannerProgressProperties()``: ``"name TYPE"`` -> a function returning the value
+as a string) and stores them with ``"time REAL"``, the seconds since the solve started;
+the first sample is taken one period after the start, none after the solve returns.
+:class:`ProgressSampler` does the same in a Python thread of the run's process.
+
+Where the properties come from (:func:`progress_properties`):
+
+* this package's planners: ``planner.progressProperties()`` (``iterations``, ``best cost``,
+  tree sizes);
+* stock planners: OMPL 2.0's bindings cannot return ``getPlannerProgressProperties()``, so
+  the properties are rebuilt from the bound methods that read the same counters
+  (:data:`STOCK_PROGRESS`): ``RRTstar`` and its informed variants, ``BITstar`` and
+  ``PRM``. These methods are safe to call during ``solve`` from Python because the run's
+  validity checker is a Python callable (the run counts checks), so the solving thread
+  returns to Python, where the sampler can take its turn, at every check.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from types import TracebackType
+from typing import Any
+
+from ompl import base as ob
+from ompl import geometric as og
+
+#: OMPL's ``Benchmark::Request::timeBetweenUpdates`` default (s).
+SAMPLE_PERIOD = 0.05
+
+ProgressProperties = dict[str, Callable[[], str]]
+
+
+def _real(value: float) -> str:
+    """A real as OMPL's ``ompl::toString`` writes it (``operator<<``: 6 significant digits)."""
+    return f"{value:g}"
+
+
+def _rrtstar_progress(planner: Any) -> ProgressProperties:
+    """``RRTstar``'s properties (RRTstar.cpp: ``iterations INTEGER``, ``best cost REAL``)."""
+    return {
+        "iterations INTEGER": lambda: str(planner.numIterations()),
+        "best cost REAL": lambda: _real(planner.bestCost().value()),
+    }
+
+
+def _bitstar_progress(planner: Any) -> ProgressProperties:
+    """The bound ones of ``BITstar``'s properties (BITstar.cpp names them ``best cost DOUBLE``, ...)."""
+    return {
+        "best cost DOUBLE": lambda: _real(planner.bestCost().value()),
+        "iterations INTEGER": lambda: str(planner.numIterations()),
+        "batches INTEGER": lambda: str(planner.numBatches()),
+    }
+
+
+def _prm_progress(planner: Any) -> ProgressProperties:
+    """The bound ones of ``PRM``'s properties (PRM.cpp: ``milestone count``, ``edge count``)."""
+    return {
+        "milestone count INTEGER": lambda: str(planner.milestoneCount()),
+        "edge count INTEGER": lambda: str(planner.edgeCount()),
+    }
+
+
+#: Stock planner classes (and their subclasses) -> their progress properties from bound methods.
+STOCK_PROGRESS: tuple[tuple[type, Callable[[Any], ProgressProperties]], ...] = (
+    (og.RRTstar, _rrtstar_progress),  # InformedRRTstar and SORRTstar derive from it
+    (og.BITstar, _bitstar_progress),
+    (og.PRM, _prm_progress),
+)
+
+
+def progress_properties(planner: ob.Planner) -> ProgressProperties:
+    """The planner's progress properties (``{}`` when it reports none)."""
+    if hasattr(planner, "progressProperties"):
+        return dict(planner.progressProperties())
+    for cls, properties in STOCK_PROGRESS:
+        if isinstance(planner, cls):
+            return properties(planner)
+    return {}
+
+
+class ProgressSampler:
+    """Samples ``properties`` every ``period`` seconds in a thread while the ``with`` block runs.
+
+    ``names`` are ``"time REAL"`` and the property names, sorted (the order of OMPL's log);
+    ``samples`` one list of values per sample in that order. A property whose function
+    raises is recorded empty for that sample.
+    """
+
+    def __init__(self, properties: ProgressProperties, period: float = SAMPLE_PERIOD) -> None:
+        self.period = period
+        self.names = sorted(["time REAL", *properties])
+        self.samples: list[list[str]] = []
+        self._properties = properties
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._sample, name="progress sampler", daemon=True)
+        self._began = 0.0
+
+    def __enter__(self) -> ProgressSampler:
+        self._began = time.perf_counter()
+        if self._properties:
+            self._thread.start()
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, traceback: TracebackType | None
+    ) -> None:
+        self._done.set()
+        if self._thread.is_alive():
+            self._thread.join()
+
+    def _sample(self) -> None:
+        while not self._done.wait(self.period):
+            values = {"time REAL": repr(time.perf_counter() - self._began)}
+            for name, read in self._properties.items():
+                try:
+                    values[name] = read()
+                except Exception:  # a counter not readable yet: leave the sample empty there
+                    values[name] = ""
+            self.samples.append([values[name] for name in self.names])
