@@ -68,7 +68,7 @@ def run(
     if kind == "ours":
         planner = BallRadiusRRTstar(si)
         planner.setBallRadiusConstant(gamma)
-        planner.setMaxConnectionDistance(eta)
+        planner.setRange(eta)
         planner.setMaxIterations(iterations)
         planner.setMaxNodes(0)
         count_iterations = None

@@ -86,7 +86,7 @@ def plan(problem: OccupancyProblem, gamma: float, seed: int, iterations: int) ->
     ss = problem.setup()
     planner = BallRadiusRRTstar(ss.getSpaceInformation())
     planner.setBallRadiusConstant(gamma)
-    planner.setMaxConnectionDistance(ETA)
+    planner.setRange(ETA)
     planner.setMaxIterations(iterations)
     planner.setSeed(seed)
     ss.setPlanner(planner)

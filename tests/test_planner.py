@@ -230,12 +230,23 @@ def test_solve_called_directly_with_seconds():
     assert pdef.getSolutionPath().getStateCount() >= 2
 
 
-@pytest.mark.parametrize("bad", [0, -1.0, float("nan"), float("inf")])
-def test_solve_rejects_time_limits_that_are_not_positive(bad):
+@pytest.mark.parametrize("limit", [0, 0.0, -1.0])
+def test_solve_with_no_time_left_returns_at_once_as_stock(limit):
+    # og.RRTConnect(si).solve(0.0) returns TIMEOUT without an iteration; so does ours
     ss = get_problem("open").setup()
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     planner.setProblemDefinition(ss.getProblemDefinition())
-    with pytest.raises(ValueError, match="positive"):
+    planner.setup()
+    assert planner.solve(limit) == ob.PlannerStatus.TIMEOUT
+    assert planner.stats.iterations == 0
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
+def test_solve_rejects_time_limits_that_are_not_finite(bad):
+    ss = get_problem("open").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setProblemDefinition(ss.getProblemDefinition())
+    with pytest.raises(ValueError, match="finite number of seconds"):
         planner.solve(bad)
 
 
@@ -259,7 +270,7 @@ def test_ompl_benchmark_runs_and_logs_our_planner(tmp_path):
 def test_simple_setup_get_planner_data_does_not_crash_and_plannerdata_has_both_trees():
     _problem, ss, planner, _status = solve_problem("bug_trap")
     data = ob.PlannerData(ss.getSpaceInformation())
-    ss.getPlannerData(data)  # would abort the process if the planner defined getPlannerData
+    ss.getPlannerData(data)  # C++'s call reaches OMPL's Planner::getPlannerData: empty, no abort
     assert data.numVertices() == 0
     data = planner.plannerData()
     stats = planner.stats
@@ -267,10 +278,13 @@ def test_simple_setup_get_planner_data_does_not_crash_and_plannerdata_has_both_t
     tags = [data.getVertex(i).getTag() for i in range(data.numVertices())]
     assert tags.count(1) == stats.start_tree_size and tags.count(2) == stats.goal_tree_size
     assert data.numStartVertices() == 1 and data.numGoalVertices() == 1
-    assert data.numEdges() == data.numVertices() - 2  # every vertex but the two roots has a parent edge
-    # edges run parent -> child: a start root only has outgoing edges
-    start_root = data.getStartIndex(0)
+    # every vertex but the two roots has its tree edge, plus the edge joining the trees
+    assert data.numEdges() == data.numVertices() - 1
+    # start-tree edges run parent -> child, goal-tree edges child -> parent: both roots are ends
+    start_root, goal_root = data.getStartIndex(0), data.getGoalIndex(0)
     assert data.getIncomingEdges(start_root) == [] and data.getEdges(start_root)
+    assert data.getEdges(goal_root) == [] and data.getIncomingEdges(goal_root)
+    assert data.properties["approx goal distance REAL"] == "0"  # solved: the trees met
 
 
 # -- statuses -------------------------------------------------------------------------
@@ -403,7 +417,7 @@ ROUND_TRIPS = {
     "balance_tree_sizes": ("0", "0"),
     "max_tree_size_ratio": ("2.5", "2.5"),
     "seed": ("42", "42"),
-    # the classroom-variant policies (issue #6; tests/test_variants.py)
+    # the classroom-variant policies (tests/test_variants.py)
     "swap_policy": ("on_collision", "on_collision"),
     "swap_steps": ("7", "7"),
     "nearest_policy": ("exhaustion", "exhaustion"),
@@ -412,6 +426,7 @@ ROUND_TRIPS = {
     "sample_policy": ("goal_ball", "goal_ball"),
     "goal_bias": ("0.25", "0.25"),
     "min_quality": ("0.1", "0.1"),
+    "uniform_rate": ("0.2", "0.2"),
 }
 
 
