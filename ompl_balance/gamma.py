@@ -62,7 +62,7 @@ STOP_CHECK_EVERY = 100
 
 
 class EstimateInterruptedError(Exception):
-    """:func:`estimate_free_measure` was stopped (its ``stop`` condition said so) before it finished."""
+    """:func:`estimate_free_measure` was stopped (its ``stop`` condition said so) before its first sample."""
 
 
 def unit_ball_volume(d: int) -> float:
@@ -161,8 +161,10 @@ def estimate_free_measure(
     (other components, such as SE2's heading, then contribute their whole measure).
 
     ``stop`` (e.g. a ``PlannerTerminationCondition``) is asked every
-    :data:`STOP_CHECK_EVERY` samples; when it returns true, the estimate is abandoned
-    with :class:`EstimateInterruptedError`.
+    :data:`STOP_CHECK_EVERY` samples; when it returns true, sampling ends and the estimate
+    is made from the samples drawn so far (``samples`` says how many; the interval is wider
+    and still holds the true measure with probability ``confidence``), or, before the
+    first sample, :class:`EstimateInterruptedError` is raised.
     """
     if not 0 < confidence < 1:
         raise ValueError(f"confidence must be in (0, 1), got {confidence!r}")
@@ -184,20 +186,23 @@ def estimate_free_measure(
     if not si.isSetup():
         si.setup()
     points = points_for(si, rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng))
-    free = 0
-    for drawn in range(int(samples)):
+    free = drawn = 0
+    while drawn < samples:
         if stop is not None and drawn % STOP_CHECK_EVERY == 0 and stop():
-            raise EstimateInterruptedError(f"stopped after {drawn} of {samples} samples")
+            if drawn == 0:
+                raise EstimateInterruptedError("stopped before the first sample")
+            break
         free += bool(si.isValid(points.ompl_state(points.sample())))
-    fraction = free / samples
-    low, high = clopper_pearson(free, int(samples), confidence)
+        drawn += 1
+    fraction = free / drawn
+    low, high = clopper_pearson(free, drawn, confidence)
     return FreeMeasure(
         fraction * space_measure,
         low * space_measure,
         high * space_measure,
         fraction,
         space_measure,
-        int(samples),
+        drawn,
         confidence,
         False,
     )

@@ -44,8 +44,8 @@ class RRTstarSettings(Settings):
         "auto",
         "gamma (distance^d) of the rewiring radius min(rewire_factor * (gamma log N / N)^(1/d), range); auto "
         "estimates gamma* for the problem's free space at the first solve (ompl_balance.gamma."
-        f"estimate_ball_radius_constant, {AUTO_GAMMA_SAMPLES} validity checks within the solve's time, not "
-        "counted in its stats)",
+        f"estimate_ball_radius_constant, {AUTO_GAMMA_SAMPLES} validity checks within the solve's time, fewer "
+        "if it runs out, not counted in its stats)",
         kind=float,
         low=0.0,
         low_open=True,
@@ -284,7 +284,8 @@ class BallRadiusRRTstar(TreePlanner):
 
     def getBallRadiusConstantInUse(self) -> float:  # noqa: N802
         """The ``gamma`` the next solve uses: in ``auto`` mode the estimate, made now if no
-        solve made it yet (it is kept until ``setup()`` or ``clear()``)."""
+        solve made it yet (kept until ``setup()``; a solve whose time ran out during the
+        estimate keeps one from the samples it drew)."""
         gamma = self._gamma_in_use()
         if gamma is None:
             gamma = self._estimated_gamma = self._estimate_gamma()
@@ -325,7 +326,7 @@ class BallRadiusRRTstar(TreePlanner):
             try:
                 self._estimated_gamma = self._estimate_gamma(ptc)
             except EstimateInterruptedError:
-                ou.OMPL_INFORM(f"{self.getName()}: the time ran out while estimating ball_radius_constant")
+                ou.OMPL_INFORM(f"{self.getName()}: the time ran out before ball_radius_constant was estimated")
 
     def _neighbours(self, tree: Tree, point: Any, dimension: int, gamma: float) -> tuple[np.ndarray, np.ndarray]:
         """The nodes a new state at ``point`` is connected and rewired against, and their distances:
