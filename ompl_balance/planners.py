@@ -111,8 +111,9 @@ class RRTConnectSettings(Settings):
     )
     uniform_rate: float = param(
         0.1,
-        "probability that an iteration of goal_ball or valid_sampler targets a uniform sample of the whole space "
-        "instead, which keeps those policies probabilistically complete; 0: their targets only (the strict rule)",
+        "probability that an iteration of goal_ball, neighbour_quality or valid_sampler targets a uniform sample "
+        "of the whole space instead, which keeps those policies probabilistically complete; 0: their targets "
+        "only (the strict rules)",
         low=0.0,
         high=1.0,
         suggestion="0.:.05:1.",

@@ -291,7 +291,7 @@ class SampleContext:
     find_nearest: NearestFinder | None = None  # the nearest policy (None: tree.nearest)
     goal_bias: float = 0.05
     min_quality: float = 0.0
-    uniform_rate: float = 0.0  # goal_ball, valid_sampler: probability of a uniform target instead
+    uniform_rate: float = 0.0  # goal_ball, neighbour_quality, valid_sampler: probability of a uniform target
     valid_sampler: ob.ValidStateSampler | None = None
     checker: Any = None  # the counting validity checker, to attribute checks to the sampler
     scratch: ob.State | None = None  # an OMPL state the valid-state sampler writes into
@@ -310,11 +310,13 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
     ``valid_sampler``      a sample of ``context.valid_sampler``, or a uniform sample when it
                            finds none (free space has no state near an obstacle).
 
-    ``goal_ball`` and ``valid_sampler`` never target some states (those outside the ball,
-    those far from obstacles), which can leave a problem unsolved for ever; with
-    probability ``context.uniform_rate`` their iteration targets a uniform sample instead,
-    which makes them probabilistically complete as RRT-Connect is. The rejecting policies
-    give up the iteration after :data:`SAMPLE_ATTEMPTS` draws.
+    ``goal_ball``, ``neighbour_quality`` and ``valid_sampler`` never target some states
+    (those outside the ball; those whose nearest node has quality 0 under ``min_quality``
+    0, such as the costliest node of a tree; those far from obstacles), which can leave a
+    problem unsolved for ever. With probability ``context.uniform_rate`` their iteration
+    targets a uniform sample instead, which makes them probabilistically complete as
+    RRT-Connect is. The rejecting policies give up the iteration after
+    :data:`SAMPLE_ATTEMPTS` draws.
     """
     points, start_tree, goal_tree = context.points, context.start_tree, context.goal_tree
     uniform, distance, random, counts = points.sample, points.distance, context.random, context.counts
@@ -350,6 +352,8 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
         min_quality, find_nearest = context.min_quality, context.find_nearest
 
         def quality_accepted(grow_start: bool) -> tuple[Any, int | None]:
+            if uniform_rate > 0.0 and random() < uniform_rate:
+                return uniform(), None
             tree = start_tree if grow_start else goal_tree
             start, goal = start_tree.state(0), goal_tree.state(0)
             tree_costs = costs[tree]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
 import time
 
 import pytest
@@ -14,7 +15,7 @@ from ompl import tools as ot
 from ompl import util as ou
 from pathcheck import assert_valid_solution
 
-from ompl_balance import BalancedRRTConnect, balance_choice, read_work, tree_size_ratio
+from ompl_balance import BalancedRRTConnect, BallRadiusRRTstar, balance_choice, read_work, tree_size_ratio
 from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
@@ -504,3 +505,42 @@ def test_fixed_seed_parameter_repeats_the_path_in_one_process():
         path = ss.getSolutionPath()
         paths.append([path.getState(i)[j] for i in range(path.getStateCount()) for j in range(2)])
     assert paths[0] == paths[1]
+
+
+# -- progress properties ----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("planner_class", [BalancedRRTConnect, BallRadiusRRTstar])
+def test_progress_properties_read_live_from_another_thread(planner_class):
+    ss = get_problem("maze").setup()
+    planner = planner_class(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    properties = planner.progressProperties()
+    trees = (
+        ["start tree size INTEGER", "goal tree size INTEGER"]
+        if planner_class is BalancedRRTConnect
+        else ["tree size INTEGER"]
+    )
+    assert list(properties) == ["iterations INTEGER", "best cost REAL", *trees]
+    samples, done = [], threading.Event()
+
+    def sample() -> None:
+        while not done.is_set():
+            samples.append({name: value() for name, value in properties.items()})
+            time.sleep(0.001)
+
+    sampler = threading.Thread(target=sample)
+    sampler.start()
+    ss.solve(0.5)
+    done.set()
+    sampler.join()
+    final = {name: value() for name, value in planner.progressProperties().items()}
+    assert int(final["iterations INTEGER"]) == planner.stats.iterations
+    assert len(samples) > 10
+    for name in ["iterations INTEGER", *trees]:
+        values = [int(s[name]) for s in samples]
+        assert values == sorted(values) and values[-1] <= int(final[name])
+    costs = [float(s["best cost REAL"]) for s in samples]
+    assert all(later <= earlier for earlier, later in itertools.pairwise(costs))
+    if planner.stats.status == "Exact solution":
+        assert float(final["best cost REAL"]) == pytest.approx(ss.getSolutionPath().length())

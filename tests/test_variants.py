@@ -643,30 +643,23 @@ def so2_setup() -> og.SimpleSetup:
     return ss
 
 
-def test_gaussian_passage_solves_the_circle_in_every_run():
+@pytest.mark.parametrize("preset", ["GaussianPassageRRTConnect", "NeighbourCostRRTConnect"])
+def test_presets_solve_the_circle_in_every_run_and_their_strict_rules_do_not(preset):
+    """Near obstacles only (the passage sampler), or never from the costliest node (neighbour
+    quality with min_quality 0): the far side of the circle is never targeted."""
     ss = so2_setup()
     ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
     assert ss.solve(2.0) == ob.PlannerStatus.EXACT_SOLUTION
     for _ in range(5):
         ss = so2_setup()
-        planner = GaussianPassageRRTConnect(ss.getSpaceInformation())
+        planner = PRESETS[preset](ss.getSpaceInformation())
         ss.setPlanner(planner)
         assert ss.solve(2.0) == ob.PlannerStatus.EXACT_SOLUTION
         path = ss.getSolutionPath()
         assert path.check() and all(not 0.5 <= path.getState(i).value <= 1.0 for i in range(path.getStateCount()))
-    # strictly near obstacles, targets never lie on the far side of the circle
     ss = so2_setup()
-    planner = GaussianPassageRRTConnect(ss.getSpaceInformation())
+    planner = PRESETS[preset](ss.getSpaceInformation())
     planner.setUniformRate(0.0)
     ss.setPlanner(planner)
     iterations = iter(range(500))
     assert ss.solve(ob.PlannerTerminationCondition(lambda: next(iterations, None) is None)) == ob.PlannerStatus.TIMEOUT
-
-
-def test_valid_sampler_with_a_fixed_seed_is_refused_at_setup():
-    ss = get_problem("open").setup()
-    planner = BalancedRRTConnect(ss.getSpaceInformation())
-    assert planner.params().setParams({"sample_policy": "valid_sampler", "seed": "3"})
-    ss.setPlanner(planner)
-    with pytest.raises(ValueError, match=r"valid_sampler.*seed"):
-        ss.setup()
