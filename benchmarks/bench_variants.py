@@ -38,7 +38,7 @@ from ompl_balance.planners import PRESETS
 from ompl_balance.worlds.boxes import PROBLEMS, Problem
 
 #: The report's averages: (time s, nodes, collision queries); "plain" is RRT-Connect.
-LAB = {
+REPORT = {
     "plain": (39.4, 11660, 579757),
     "SwapLimitRRTConnect": (3.7, 1866, 45541),
     "CollisionSwapRRTConnect": (21.6, 10732, 536918),
@@ -65,7 +65,10 @@ def strict(preset: str) -> Callable[[ob.SpaceInformation], ob.Planner]:
 
 
 #: Run only when named in ``--planners``.
-STRICT = {f"{name}[uniform_rate=0]": strict(name) for name in ("ControlChosenRRTConnect", "GaussianPassageRRTConnect")}
+STRICT = {
+    f"{name}[uniform_rate=0]": strict(name)
+    for name in ("NeighbourCostRRTConnect", "GaussianPassageRRTConnect", "ControlChosenRRTConnect")
+}
 
 #: A ratio within this band of 1 reads as "same": differences of less than 10 %.
 SAME_BAND = 0.1
@@ -208,13 +211,13 @@ def main() -> None:
     print("| preset | report | " + " | ".join(problems) + " | goes the report's way |")
     print("|---|---|" + "---|" * len(problems) + "---|")
     for name in planners:
-        if name not in LAB:
+        if name not in REPORT:
             continue
-        lab = LAB[name][2] / LAB["plain"][2]
+        report = REPORT[name][2] / REPORT["plain"][2]
         ours = [query_ratios[name][problem] for problem in problems]
-        agree = sum(effect(ratio) == effect(lab) for ratio in ours)
+        agree = sum(effect(ratio) == effect(report) for ratio in ours)
         cells = " | ".join(f"{ratio:.2f} ({effect(ratio)})" for ratio in ours)
-        print(f"| {name} | {lab:.2f} ({effect(lab)}) | {cells} | {agree} of {len(ours)} |")
+        print(f"| {name} | {report:.2f} ({effect(report)}) | {cells} | {agree} of {len(ours)} |")
 
 
 if __name__ == "__main__":

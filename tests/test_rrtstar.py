@@ -53,9 +53,7 @@ def test_se2_rooms_path_is_valid():
     problem = rooms_problem(se2=True)
     ss = problem.setup()
     # SE(2) runs on OMPL's sampler (the seed parameter does not apply): stop at the first path
-    planner = _planner(
-        ss, range="6", max_iterations="0", goal_bias="0.2", continue_after_goal_reached="0"
-    )
+    planner = _planner(ss, range="6", max_iterations="0", goal_bias="0.2", continue_after_goal_reached="0")
     assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
     si = ss.getSpaceInformation()
     start, goal = si.allocState(), si.allocState()
@@ -98,9 +96,7 @@ def test_estimated_gamma_beats_the_default_of_100_at_equal_iterations():
         costs = []
         for seed in range(1, 11):
             ss = problem.setup()
-            planner = _planner(
-                ss, ball_radius_constant=gamma, range="4", max_iterations="1000", seed=str(seed)
-            )
+            planner = _planner(ss, ball_radius_constant=gamma, range="4", max_iterations="1000", seed=str(seed))
             ss.solve(60.0)
             assert planner.stats.iterations == 1000
             costs.append(planner.stats.best_cost)
@@ -124,9 +120,7 @@ def test_cost_threshold_stops_at_the_first_solution():
 
 def test_not_continuing_after_the_goal_stops_at_the_first_solution():
     ss = rooms_problem().setup()
-    planner = _planner(
-        ss, range="4", max_iterations="3000", seed="3", continue_after_goal_reached="0"
-    )
+    planner = _planner(ss, range="4", max_iterations="3000", seed="3", continue_after_goal_reached="0")
     assert ss.solve(30.0)
     assert planner.stats.iterations == planner.stats.first_solution_iteration
 
@@ -148,9 +142,7 @@ def test_same_seed_same_run():
     runs = []
     for _ in range(2):
         ss = rooms_problem().setup()
-        planner = _planner(
-            ss, range="4", max_iterations="300", seed="11", ball_radius_constant="auto"
-        )
+        planner = _planner(ss, range="4", max_iterations="300", seed="11", ball_radius_constant="auto")
         ss.solve(30.0)
         runs.append((planner.getBallRadiusConstantInUse(), planner.stats.best_costs, planner.stats.states_checked))
     assert runs[0][0] == runs[1][0] and runs[0][2] == runs[1][2]
