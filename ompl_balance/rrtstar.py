@@ -3,8 +3,9 @@
 The radius schedule is ``min((gamma log N / N)^(1/d), eta)`` (:func:`~ompl_balance.gamma.rewire_radius`),
 as in MATLAB's ``plannerRRTStar`` and its example "Calculating an Appropriate
 BallRadiusConstant for plannerRRTStar"; :mod:`ompl_balance.gamma` estimates ``gamma`` for a
-problem. The loop is OMPL's ``RRTstar`` (``src/ompl/geometric/planners/rrt/src/RRTstar.cpp``,
-radius mode, delayed collision checking).
+problem. The loop is OMPL's ``RRTstar`` (``src/ompl/geometric/planners/rrt/src/RRTstar.cpp``)
+with og.RRTstar's parameters where they mean the same (``range``, ``rewire_factor``,
+k-nearest mode, delayed collision checking, tree pruning).
 """
 
 from __future__ import annotations

@@ -4,13 +4,17 @@ Two stores with one interface (:class:`Tree`), chosen by :mod:`ompl_balance.core
 
 :class:`ArrayTree`
     real-vector states in one contiguous ``(capacity, dim)`` float64 array grown by
-    doubling; nearest and near neighbours by one compiled scan of all nodes (exact).
+    doubling; nearest and near neighbours by a scan of all nodes (exact): numpy while
+    the process's trees are small, the compiled kernels of :mod:`ompl_balance.core.scans`
+    once a tree has reached :data:`COMPILED_SCANS_FROM` nodes and they have loaded in a
+    background thread (so that no solve waits for numba), the same answers either way.
 :class:`StateTree`
     OMPL states of any space in a list; nearest neighbour by ``si.distance`` over all
     nodes (exact, slower: one call into OMPL per node).
 
 Both keep, per node, the index of its parent (``-1`` for a root) and of its root, so
-a path is read off by following parents. Node ``i`` is the ``i``-th state added.
+a path is read off by following parents. Node ``i`` is the ``i``-th state added (until
+:meth:`Tree.compact` removes nodes and renumbers the rest in order).
 """
 
 from __future__ import annotations
@@ -217,7 +221,12 @@ class ArrayTree(_Links):
         return index
 
     def _compiled(self) -> ModuleType | None:
-        return compiled_scans() if self.size >= COMPILED_SCANS_FROM else None
+        """The compiled scans once loaded (whatever the size); their loading starts when a
+        tree first reaches :data:`COMPILED_SCANS_FROM` nodes."""
+        scans = _LOADER.scans
+        if scans is None and self.size >= COMPILED_SCANS_FROM:
+            scans = compiled_scans()
+        return scans
 
     def nearest(self, state: np.ndarray) -> tuple[int, float]:
         """Index of the node closest to ``state`` (Euclidean; the first on ties) and its distance."""
