@@ -16,7 +16,7 @@ from ompl import util as ou
 from pathcheck import assert_valid_solution
 
 from ompl_balance import BalancedRRTConnect, BallRadiusRRTstar, balance_choice, read_work, tree_size_ratio
-from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, get_problem
+from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, Problem, get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
 
@@ -510,9 +510,14 @@ def test_fixed_seed_parameter_repeats_the_path_in_one_process():
 # -- progress properties ----------------------------------------------------------------------
 
 
+#: A wall across the square: RRT-Connect plans until the time limit.
+WALL = Problem("wall", "a wall across the square", ((0.45, 0.0, 0.55, 1.0),), (0.1, 0.5), (0.9, 0.5))
+
+
 @pytest.mark.parametrize("planner_class", [BalancedRRTConnect, BallRadiusRRTstar])
 def test_progress_properties_read_live_from_another_thread(planner_class):
-    ss = get_problem("maze").setup()
+    # both plan until the time limit: RRT-Connect cannot pass the wall, RRT* keeps improving
+    ss = (WALL if planner_class is BalancedRRTConnect else get_problem("maze")).setup()
     planner = planner_class(ss.getSpaceInformation())
     ss.setPlanner(planner)
     properties = planner.progressProperties()

@@ -121,9 +121,9 @@ class _Links:
         self.size = 0
 
 
-#: Tree size from which :class:`ArrayTree` scans with the compiled kernels: smaller trees
-#: scan with numpy, and a tree reaching this size starts loading the kernels in the
-#: background (``benchmarks/bench_rrtc.py --scans`` measures the trade-off).
+#: Tree size at which an :class:`ArrayTree` starts loading the compiled kernels in the
+#: background; until they are loaded, every tree scans with numpy, afterwards every tree
+#: with the kernels (``benchmarks/bench_rrtc.py --scans`` measures the trade-off).
 COMPILED_SCANS_FROM = 1024
 
 
@@ -189,10 +189,10 @@ def _squared_distances(states: np.ndarray, query: np.ndarray) -> np.ndarray:
 class ArrayTree(_Links):
     """Real-vector states of one tree, shape ``(len(tree), dim)``.
 
-    Nearest and near queries scan all nodes (exact): with numpy while the tree is small,
-    in one compiled loop once it has :data:`COMPILED_SCANS_FROM` nodes and the kernels are
-    loaded (for the tree sizes sampling planners reach, faster than any index would be
-    from Python). Both scans return the same answers.
+    Nearest and near queries scan all nodes (exact): with numpy until the compiled kernels
+    are loaded (a tree of :data:`COMPILED_SCANS_FROM` nodes starts their loading), then in
+    one compiled loop (for the tree sizes sampling planners reach, faster than any index
+    would be from Python). Both scans return the same answers.
     """
 
     def __init__(self, dim: int, capacity: int = 1024) -> None:
