@@ -541,7 +541,7 @@ def test_progress_properties_read_live_from_another_thread(planner_class):
     sampler.join()
     final = {name: value() for name, value in planner.progressProperties().items()}
     assert int(final["iterations INTEGER"]) == planner.stats.iterations
-    assert len(samples) > 10
+    assert len({sample["iterations INTEGER"] for sample in samples}) >= 3  # seen while it ran
     for name in ["iterations INTEGER", *trees]:
         values = [int(s[name]) for s in samples]
         assert values == sorted(values) and values[-1] <= int(final[name])
