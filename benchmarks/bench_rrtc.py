@@ -13,7 +13,19 @@ runs interleaved so the machine's slow phases hit all planners alike):
   time per motion checked (every iteration checks at least one motion) of ours over
   stock's.
 
+With ``--scans``, instead: how the tree scans' loading pays off (``ompl_balance.core.trees``).
+Each run is a fresh process solving an impossible problem (a wall across the unit
+cube, 2-D and 7-D, free checks) for ``--seconds``; per scan mode, the median iterations
+and nodes (both trees) reached and the solve's wall time:
+
+* ``numpy``: numpy scans whatever the tree size (the kernels never load);
+* ``compiled``: the kernels loaded before the solve, used from the first node (the cost
+  every planner's ``setup()`` used to pay inside ``SimpleSetup.solve``, not counted here);
+* ``default``: numpy scans, and the kernels loaded in the background once a tree reaches
+  ``COMPILED_SCANS_FROM`` nodes, then used.
+
 Run: python benchmarks/bench_rrtc.py [--runs 30]
+     python benchmarks/bench_rrtc.py --scans [--runs 5] [--seconds 2,5]
 """
 
 from __future__ import annotations
@@ -21,6 +33,8 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
+import subprocess
+import sys
 import time
 
 from ompl import base as ob
@@ -100,14 +114,85 @@ def run(make_setup, make_planner, time_limit: float) -> dict:
     }
 
 
+SCAN_RUN = """
+import sys, time
+from ompl import base as ob, geometric as og, util as ou
+ou.setLogLevel(ou.LOG_ERROR)
+from ompl_balance import BalancedRRTConnect
+from ompl_balance.core import trees
+mode, seconds, dim = sys.argv[1], float(sys.argv[2]), int(sys.argv[3])
+if mode == "numpy":
+    trees.COMPILED_SCANS_FROM = 10**12
+elif mode == "compiled":
+    trees.load_scans()
+    trees.COMPILED_SCANS_FROM = 0
+space = ob.RealVectorStateSpace(dim)
+space.setBounds(0.0, 1.0)
+ss = og.SimpleSetup(space)
+ss.setStateValidityChecker(lambda state: not 0.45 < state[0] < 0.55)
+start, goal = space.allocState(), space.allocState()
+for i in range(dim):
+    start[i] = goal[i] = 0.5
+start[0], goal[0] = 0.1, 0.9
+ss.setStartAndGoalStates(start, goal)
+planner = BalancedRRTConnect(ss.getSpaceInformation())
+planner.setSeed(3)
+ss.setPlanner(planner)
+began = time.perf_counter()
+ss.solve(seconds)
+stats = planner.stats
+print(time.perf_counter() - began, stats.iterations, stats.start_tree_size + stats.goal_tree_size)
+"""
+
+SCAN_MODES = ("numpy", "compiled", "default")
+
+
+def scans_main(runs: int, seconds: list[float]) -> None:
+    """The ``--scans`` table (see the module docstring)."""
+    from ompl_balance.core.trees import COMPILED_SCANS_FROM
+
+    print(
+        f"{runs} fresh processes per cell (modes interleaved); impossible problem; "
+        f"COMPILED_SCANS_FROM = {COMPILED_SCANS_FROM}\n"
+    )
+    print("| dim | seconds | mode | median iterations | median nodes | median solve time (s) | iterations x numpy |")
+    print("|---|---|---|---|---|---|---|")
+    for dim in (2, 7):
+        for limit in seconds:
+            results: dict[str, list[list[float]]] = {mode: [] for mode in SCAN_MODES}
+            for _ in range(runs):
+                for mode in SCAN_MODES:
+                    out = subprocess.run(
+                        [sys.executable, "-c", SCAN_RUN, mode, str(limit), str(dim)],
+                        capture_output=True,
+                        text=True,
+                        check=True,
+                    ).stdout.split()
+                    results[mode].append([float(value) for value in out])
+            medians = {mode: [statistics.median(column) for column in zip(*rows)] for mode, rows in results.items()}
+            for mode in SCAN_MODES:
+                elapsed, iterations, nodes = medians[mode]
+                ratio = iterations / medians["numpy"][1]
+                print(
+                    f"| {dim} | {limit:g} | {mode} | {iterations:.0f} | {nodes:.0f} | {elapsed:.3f} | {ratio:.2f} |",
+                    flush=True,
+                )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--runs", type=int, default=30, help="runs per planner and problem (default 30)")
+    parser.add_argument("--runs", type=int, default=None, help="runs per cell (default 30; 5 with --scans)")
     parser.add_argument("--time-limit", type=float, default=30.0, help="seconds per run (default 30)")
     parser.add_argument(
         "--problems", default=",".join(PROBLEMS), help="comma-separated subset of " + ", ".join(PROBLEMS)
     )
+    parser.add_argument("--scans", action="store_true", help="measure the tree scans' loading instead")
+    parser.add_argument("--seconds", default="1,2,5", help="--scans: comma-separated solve times (default 1,2,5)")
     args = parser.parse_args()
+    if args.scans:
+        scans_main(args.runs or 5, [float(value) for value in args.seconds.split(",")])
+        return
+    args.runs = args.runs or 30
     ou.RNG.setSeed(1)
     ou.setLogLevel(ou.LOG_WARN)
 

@@ -29,7 +29,7 @@ from ompl import util as ou
 
 from ompl_balance.core.counting import read_work
 from ompl_balance.gamma import ball_radius_constant, ompl_rewire_factor
-from ompl_balance.planners import BallRadiusRRTstar
+from ompl_balance.rrtstar import BallRadiusRRTstar
 from ompl_balance.worlds.occupancy import OccupancyGrid, OccupancyProblem, rooms_problem
 
 
@@ -68,7 +68,7 @@ def run(
     if kind == "ours":
         planner = BallRadiusRRTstar(si)
         planner.setBallRadiusConstant(gamma)
-        planner.setMaxConnectionDistance(eta)
+        planner.setRange(eta)
         planner.setMaxIterations(iterations)
         planner.setMaxNodes(0)
         count_iterations = None

@@ -7,16 +7,19 @@ sampler: one counter, no double counting), median nodes (both trees; stock's fro
 Runs are interleaved (run i of every planner, then run i + 1) so slow phases of the
 shared machine hit all planners alike.
 
-Then, per preset, the lab's collision-query ratio to plain RRT-Connect (issue #6, their
-6-DOF problem, 10 runs, averages) next to ours on each problem, and on how many of our
-problems the change goes the lab's way: each ratio read as "fewer" (< 0.9), "same"
-(0.9 to 1.1) or "more" (> 1.1) queries, and the lab's way reproduced where the words match.
+Then, per preset, the collision-query ratio to plain RRT-Connect that the TU Berlin lab
+report "RRT Extensions" (2020) measured (their 6-DOF problem, 10 runs, averages) next to
+ours on each problem, and on how many of our problems the change goes the report's way:
+each ratio read as "fewer" (< 0.9), "same" (0.9 to 1.1) or "more" (> 1.1) queries.
 
-Problems: the built-in 2-D suite (``ompl_balance.worlds.boxes``). With ``--mbm N``, also the
-first N problems of each MotionBenchMaker Panda scenario in ``../shared/data/mbm/panda``
-with VAMP's Panda (exact FCL checks, ~0.3-0.5 ms per state: keep N small).
+Problems: the built-in 2-D suite (``ompl_balance.worlds.boxes``), ``twin_pockets`` (start and
+goal in pockets that open away from each other: every way out leaves the goal ball of
+``ControlChosenRRTConnect``) and ``circle`` (SO(2), an obstacle between 0.5 and 1.0 rad,
+start 0, goal 1.5: the way goes round the far side, where no obstacle is near). With
+``--mbm N``, also the first N problems of each shipped MotionBenchMaker Panda scenario with
+VAMP's Panda (exact FCL checks, ~0.3-0.5 ms per state: keep N small).
 
-Run: python benchmarks/bench_variants.py [--runs 20] [--time-limit 10] [--mbm 0]
+Run: python benchmarks/bench_variants.py [--runs 20] [--time-limit 10] [--mbm 0] [--planners ...]
 """
 
 from __future__ import annotations
@@ -24,20 +27,18 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
-from pathlib import Path
+from collections.abc import Callable
 
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ompl_balance.core.counting import measured_solve
+from ompl_balance.core.counting import CountingValidityChecker, measured_solve
 from ompl_balance.planners import PRESETS
-from ompl_balance.worlds.boxes import PROBLEMS
+from ompl_balance.worlds.boxes import PROBLEMS, Problem
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-
-#: The lab's averages (issue #6): (time s, nodes, collision queries); "plain" is RRT-Connect.
-LAB = {
+#: The report's averages: (time s, nodes, collision queries); "plain" is RRT-Connect.
+REPORT = {
     "plain": (39.4, 11660, 579757),
     "SwapLimitRRTConnect": (3.7, 1866, 45541),
     "CollisionSwapRRTConnect": (21.6, 10732, 536918),
@@ -51,8 +52,60 @@ LAB = {
 
 PLANNERS = {"RRTConnect": og.RRTConnect, **PRESETS}
 
+
+def strict(preset: str) -> Callable[[ob.SpaceInformation], ob.Planner]:
+    """``preset`` with ``uniform_rate = 0``: targets from its sample policy only."""
+
+    def make(si: ob.SpaceInformation) -> ob.Planner:
+        planner = PRESETS[preset](si)
+        planner.setUniformRate(0.0)
+        return planner
+
+    return make
+
+
+#: Run only when named in ``--planners``.
+STRICT = {
+    f"{name}[uniform_rate=0]": strict(name)
+    for name in ("NeighbourCostRRTConnect", "GaussianPassageRRTConnect", "ControlChosenRRTConnect")
+}
+
 #: A ratio within this band of 1 reads as "same": differences of less than 10 %.
 SAME_BAND = 0.1
+
+TWIN_POCKETS = Problem(
+    "twin_pockets",
+    "start and goal in pockets opening away from each other",
+    (
+        (0.22, 0.60, 0.45, 0.62),
+        (0.22, 0.38, 0.45, 0.40),
+        (0.43, 0.38, 0.45, 0.62),
+        (0.55, 0.60, 0.78, 0.62),
+        (0.55, 0.38, 0.78, 0.40),
+        (0.55, 0.38, 0.57, 0.62),
+    ),
+    (0.35, 0.5),
+    (0.65, 0.5),
+)
+
+
+def circle_setup() -> og.SimpleSetup:
+    """SO(2) with an obstacle between 0.5 and 1.0 rad; start 0, goal 1.5."""
+    space = ob.SO2StateSpace()
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    si.setStateValidityChecker(CountingValidityChecker(si, lambda state: not 0.5 <= state.value <= 1.0))
+    start, goal = space.allocState(), space.allocState()
+    start.value, goal.value = 0.0, 1.5
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
+SETUPS: dict[str, Callable[[], og.SimpleSetup]] = {
+    **{name: problem.setup for name, problem in PROBLEMS.items()},
+    "twin_pockets": TWIN_POCKETS.setup,
+    "circle": circle_setup,
+}
 
 
 def effect(ratio: float) -> str:
@@ -62,16 +115,16 @@ def effect(ratio: float) -> str:
     return "more" if ratio > 1 + SAME_BAND else "same"
 
 
-def mbm_problems(count: int) -> dict:
-    """``name -> make_setup`` for the first ``count`` problems of each Panda scenario."""
+def mbm_problems(count: int) -> dict[str, Callable[[], og.SimpleSetup]]:
+    """``name -> make_setup`` for the first ``count`` problems of each shipped Panda scenario."""
     from ompl_balance.collision.robots import load_panda_vamp
     from ompl_balance.validity import CollisionChecker
-    from ompl_balance.worlds.mbm import load_mbm
+    from ompl_balance.worlds.mbm import SCENARIOS, load_mbm
 
-    robot = load_panda_vamp(DATA / "robots" / "panda_vamp")
+    robot = load_panda_vamp()
     problems = {}
-    for path in sorted((DATA / "mbm" / "panda").glob("*.json")):
-        for problem in load_mbm(path, robot.joint_names)[:count]:
+    for scenario in SCENARIOS:
+        for problem in load_mbm(scenario, robot.joint_names)[:count]:
             checker = CollisionChecker(robot, problem.environment)
 
             def make_setup(problem=problem, checker=checker):
@@ -103,8 +156,15 @@ def main() -> None:
     parser.add_argument("--time-limit", type=float, default=10.0, help="seconds per run (default 10)")
     parser.add_argument(
         "--problems",
-        default=",".join(PROBLEMS),
-        help="2-D problems: comma-separated subset of " + ", ".join(PROBLEMS) + " ('' for none)",
+        default=",".join(SETUPS),
+        help="comma-separated subset of " + ", ".join(SETUPS) + " ('' for none)",
+    )
+    parser.add_argument(
+        "--planners",
+        default=",".join(PLANNERS),
+        help="comma-separated subset of "
+        + ", ".join([*PLANNERS, *STRICT])
+        + " (default: all but the [uniform_rate=0] ones; RRTConnect, the reference, always runs)",
     )
     parser.add_argument(
         "--mbm", type=int, default=0, help="also the first N problems of each MBM Panda scenario (default 0)"
@@ -113,12 +173,11 @@ def main() -> None:
     ou.RNG.setSeed(1)
     ou.setLogLevel(ou.LOG_NONE)
 
-    problems = {name: PROBLEMS[name].setup for name in args.problems.split(",") if name}
+    problems = {name: SETUPS[name] for name in args.problems.split(",") if name}
     if args.mbm > 0:
-        if (DATA / "mbm" / "panda").is_dir():
-            problems.update(mbm_problems(args.mbm))
-        else:
-            print(f"(no MotionBenchMaker data at {DATA / 'mbm' / 'panda'}: Panda problems skipped)\n")
+        problems.update(mbm_problems(args.mbm))
+    chosen = {"RRTConnect", *args.planners.split(",")}
+    planners = {name: make for name, make in {**PLANNERS, **STRICT}.items() if name in chosen}
 
     print(f"{args.runs} runs per cell, time limit {args.time_limit:g} s; ratios are to stock RRTConnect's medians\n")
     print(
@@ -126,11 +185,11 @@ def main() -> None:
         "| time ratio | queries ratio | nodes ratio |"
     )
     print("|---|---|---|---|---|---|---|---|---|")
-    query_ratios: dict[str, dict[str, float]] = {name: {} for name in PLANNERS}
+    query_ratios: dict[str, dict[str, float]] = {name: {} for name in planners}
     for problem, make_setup in problems.items():
-        results = {name: [] for name in PLANNERS}
+        results: dict[str, list[dict]] = {name: [] for name in planners}
         for _ in range(args.runs):
-            for name, make_planner in PLANNERS.items():
+            for name, make_planner in planners.items():
                 results[name].append(run(make_setup, make_planner, args.time_limit))
         medians = {
             name: {key: statistics.median(r[key] for r in runs) for key in ("time", "queries", "nodes")}
@@ -148,17 +207,17 @@ def main() -> None:
                 flush=True,
             )
 
-    print("\nThe lab's findings: collision-query ratio to plain RRT-Connect, theirs and ours\n")
-    print("| preset | lab | " + " | ".join(problems) + " | goes the lab's way |")
+    print('\n"RRT Extensions" (2020): collision-query ratio to plain RRT-Connect, the report\'s and ours\n')
+    print("| preset | report | " + " | ".join(problems) + " | goes the report's way |")
     print("|---|---|" + "---|" * len(problems) + "---|")
-    for name in PRESETS:
-        if name not in LAB:
+    for name in planners:
+        if name not in REPORT:
             continue
-        lab = LAB[name][2] / LAB["plain"][2]
+        report = REPORT[name][2] / REPORT["plain"][2]
         ours = [query_ratios[name][problem] for problem in problems]
-        agree = sum(effect(ratio) == effect(lab) for ratio in ours)
+        agree = sum(effect(ratio) == effect(report) for ratio in ours)
         cells = " | ".join(f"{ratio:.2f} ({effect(ratio)})" for ratio in ours)
-        print(f"| {name} | {lab:.2f} ({effect(lab)}) | {cells} | {agree} of {len(ours)} |")
+        print(f"| {name} | {report:.2f} ({effect(report)}) | {cells} | {agree} of {len(ours)} |")
 
 
 if __name__ == "__main__":

@@ -33,7 +33,7 @@ from matplotlib.collections import LineCollection
 from ompl import util as ou
 
 from ompl_balance.gamma import ball_radius_constant, estimate_ball_radius_constant, rewire_radius, unit_ball_volume
-from ompl_balance.planners import BallRadiusRRTstar
+from ompl_balance.rrtstar import BallRadiusRRTstar
 from ompl_balance.worlds.occupancy import OccupancyProblem, rooms_problem
 
 ETA = 4.0  # m, maximum connection distance on the rooms map
@@ -86,7 +86,7 @@ def plan(problem: OccupancyProblem, gamma: float, seed: int, iterations: int) ->
     ss = problem.setup()
     planner = BallRadiusRRTstar(ss.getSpaceInformation())
     planner.setBallRadiusConstant(gamma)
-    planner.setMaxConnectionDistance(ETA)
+    planner.setRange(ETA)
     planner.setMaxIterations(iterations)
     planner.setSeed(seed)
     ss.setPlanner(planner)

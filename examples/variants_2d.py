@@ -33,11 +33,11 @@ for planner_class in PRESETS.values():
 # By hand: Gaussian samples near obstacles, tree balancing, skip nodes that failed 10 times.
 ss = get_problem("bug_trap").setup()
 ss.getSpaceInformation().setValidStateSamplerAllocator(GaussianValidStateSampler)
-planner = BalancedRRTConnect(ss.getSpaceInformation(), "GaussianExhaustedRRTConnect")
+planner = BalancedRRTConnect(ss.getSpaceInformation(), name="GaussianExhaustedRRTConnect")
 planner.params().setParams(
     {
         "sample_policy": "valid_sampler",
-        "swap_policy": "balance_nodes",
+        "balance_tree_sizes": "1",
         "nearest_policy": "exhausted",
         "exhausted_after": "10",
     }

@@ -39,19 +39,30 @@ equal for every ``N`` when the factors ``c`` agree:
     rewire_factor * (2 * (1 + 1/d) * mu(X) / zeta_d) ** (1/d) = gamma ** (1/d)
     rewire_factor = (gamma * zeta_d / (2 * (1 + 1/d) * mu(X))) ** (1/d)
 
-which is what :func:`ompl_rewire_factor` computes (with OMPL's ``range`` set to ``eta``).
+which is what :func:`ompl_rewire_factor` computes (with OMPL's ``range`` set to ``eta``);
+:func:`ompl_ball_radius_constant` is the converse, the ``gamma`` of OMPL's schedule for a
+given ``rewire_factor``.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, overload
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
 from .core.spaces import points_for
+
+#: Samples :func:`estimate_free_measure` draws between two calls of its ``stop`` condition.
+STOP_CHECK_EVERY = 100
+
+
+class EstimateInterruptedError(Exception):
+    """:func:`estimate_free_measure` was stopped (its ``stop`` condition said so) before its first sample."""
 
 
 def unit_ball_volume(d: int) -> float:
@@ -76,7 +87,11 @@ def ball_radius_constant(d: int, free_measure: float) -> float:
     return 2.0**d * (1.0 + 1.0 / d) * free_measure / unit_ball_volume(d)
 
 
-def rewire_radius(n, d: int, gamma: float, eta: float = math.inf):
+@overload
+def rewire_radius(n: int, d: int, gamma: float, eta: float = math.inf) -> float: ...
+@overload
+def rewire_radius(n: np.ndarray | list[int], d: int, gamma: float, eta: float = math.inf) -> np.ndarray | float: ...
+def rewire_radius(n: Any, d: int, gamma: float, eta: float = math.inf) -> Any:
     """RRT*'s rewiring radius ``min((gamma * log(n) / n) ** (1/d), eta)`` (distance units).
 
     ``n``: number of tree nodes including the new one, an int >= 1 or an array of them
@@ -125,8 +140,9 @@ def estimate_free_measure(
     si: ob.SpaceInformation,
     samples: int = 5000,
     confidence: float = 0.95,
-    grid=None,
+    grid: Any = None,
     rng: np.random.Generator | int | None = None,
+    stop: Callable[[], Any] | None = None,
 ) -> FreeMeasure:
     """The measure of ``si``'s free space: Monte Carlo with a confidence interval, or exact.
 
@@ -143,6 +159,12 @@ def estimate_free_measure(
     the free fraction is counted exactly over the cells. This assumes the grid covers
     exactly the position bounds of the space and validity depends on position alone
     (other components, such as SE2's heading, then contribute their whole measure).
+
+    ``stop`` (e.g. a ``PlannerTerminationCondition``) is asked every
+    :data:`STOP_CHECK_EVERY` samples; when it returns true, sampling ends and the estimate
+    is made from the samples drawn so far (``samples`` says how many; the interval is wider
+    and still holds the true measure with probability ``confidence``), or, before the
+    first sample, :class:`EstimateInterruptedError` is raised.
     """
     if not 0 < confidence < 1:
         raise ValueError(f"confidence must be in (0, 1), got {confidence!r}")
@@ -164,30 +186,50 @@ def estimate_free_measure(
     if not si.isSetup():
         si.setup()
     points = points_for(si, rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng))
-    free = sum(bool(si.isValid(points.ompl_state(points.sample()))) for _ in range(int(samples)))
-    fraction = free / samples
-    from scipy.stats import binomtest  # imported here: scipy.stats takes a second to import
-
-    interval = binomtest(free, int(samples)).proportion_ci(confidence_level=confidence, method="exact")
-    low, high = interval.low, interval.high
+    free = drawn = 0
+    while drawn < samples:
+        if stop is not None and drawn % STOP_CHECK_EVERY == 0 and stop():
+            if drawn == 0:
+                raise EstimateInterruptedError("stopped before the first sample")
+            break
+        free += bool(si.isValid(points.ompl_state(points.sample())))
+        drawn += 1
+    fraction = free / drawn
+    low, high = clopper_pearson(free, drawn, confidence)
     return FreeMeasure(
         fraction * space_measure,
         low * space_measure,
         high * space_measure,
         fraction,
         space_measure,
-        int(samples),
+        drawn,
         confidence,
         False,
     )
+
+
+def clopper_pearson(successes: int, trials: int, confidence: float) -> tuple[float, float]:
+    """The Clopper-Pearson ("exact") interval of a binomial proportion at level ``confidence``.
+
+    Its ends are quantiles of beta distributions: ``B(a/2; k, n - k + 1)`` and
+    ``B(1 - a/2; k + 1, n - k)``, ``a = 1 - confidence`` (0 and 1 when ``k`` is 0 or ``n``);
+    scipy's ``binomtest(...).proportion_ci(method="exact")`` finds the same ends by root finding.
+    """
+    from scipy.special import betaincinv  # imported here, on first use: a quarter of a second
+
+    alpha = (1.0 - confidence) / 2.0
+    low = 0.0 if successes == 0 else float(betaincinv(successes, trials - successes + 1, alpha))
+    high = 1.0 if successes == trials else float(betaincinv(successes + 1, trials - successes, 1.0 - alpha))
+    return low, high
 
 
 def estimate_ball_radius_constant(
     si: ob.SpaceInformation,
     samples: int = 5000,
     confidence: float = 0.95,
-    grid=None,
+    grid: Any = None,
     rng: np.random.Generator | int | None = None,
+    stop: Callable[[], Any] | None = None,
 ) -> float:
     """``gamma*`` for ``si``'s free space (distance**d), erring on the large side.
 
@@ -196,7 +238,7 @@ def estimate_ball_radius_constant(
     ``grid`` is given), so the result is at least the theorem's bound with probability
     ``confidence``. Arguments as for :func:`estimate_free_measure`.
     """
-    free = estimate_free_measure(si, samples=samples, confidence=confidence, grid=grid, rng=rng)
+    free = estimate_free_measure(si, samples=samples, confidence=confidence, grid=grid, rng=rng, stop=stop)
     if free.high <= 0:
         raise ValueError("no valid state was sampled: the free space looks empty (check the validity checker)")
     return ball_radius_constant(si.getStateDimension(), free.high)
@@ -220,6 +262,21 @@ def ompl_rewire_factor(si: ob.SpaceInformation, gamma: float, planner: og.RRTsta
         planner.setKNearest(False)
         planner.setRewireFactor(factor)
     return factor
+
+
+def ompl_ball_radius_constant(si: ob.SpaceInformation, rewire_factor: float = 1.1) -> float:
+    """The ``gamma`` of OMPL's ``RRTstar`` radius schedule for ``rewire_factor`` (radius mode).
+
+    ``rewire_factor**d * 2 * (1 + 1/d) * si.getSpaceMeasure() / unit_ball_volume(d)``, the
+    converse of :func:`ompl_rewire_factor`: ``BallRadiusRRTstar`` with this
+    ``ball_radius_constant``, ``rewire_factor`` 1 and og.RRTstar's ``range`` rewires against
+    the same ball as ``og.RRTstar`` with ``setKNearest(False)`` and this ``rewire_factor``
+    (og.RRTstar's default is 1.1).
+    """
+    if not math.isfinite(rewire_factor) or rewire_factor <= 0:
+        raise ValueError(f"rewire_factor must be a positive finite number, got {rewire_factor!r}")
+    d = si.getStateDimension()
+    return float(rewire_factor**d * 2.0 * (1.0 + 1.0 / d) * si.getSpaceMeasure() / unit_ball_volume(d))
 
 
 def _check_dimension(d: int) -> None:

@@ -8,11 +8,10 @@ at goal states sampled while fewer than half of the goal tree's states were samp
 ``range`` defaulting to 0.2 x the space's maximum extent, the grow/connect loop, the
 planner statuses, the solution added with ``pdef.addSolutionPath``.
 
-Differences from stock, on purpose:
+Differences from stock, on purpose (``docs/drop-in.md`` lists every difference):
 
 * no approximate solutions: a run that does not connect the trees ends with
   ``TIMEOUT`` and adds no path;
-* ``plannerData()`` replaces ``getPlannerData`` (see :meth:`TreePlanner.plannerData`);
 * each solve reports a :class:`RunStats` record (``planner.stats``).
 
 The same planner carries the classroom RRT-Connect variants as policies
@@ -26,6 +25,7 @@ from __future__ import annotations
 
 import enum
 import itertools
+import math
 import sys
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -36,7 +36,7 @@ from ompl import base as ob
 from ompl import util as ou
 
 from .core.params import Settings, param
-from .core.planner import GOAL_TAG, RANGE_AS_EXTENT_FRACTION, START_TAG, TreePlanner
+from .core.planner import GOAL_TAG, RANGE_AS_EXTENT_FRACTION, START_TAG, PlannerSpecs, TreePlanner
 from .core.spaces import Points
 from .core.trees import NO_PARENT, Tree
 from .policies import (
@@ -54,7 +54,8 @@ from .policies import (
 )
 from .samplers import PassageSampler
 
-ValidStateSamplerAllocator = Callable[[ob.SpaceInformation], ob.ValidStateSampler]
+#: ``allocate(si) -> ob.ValidStateSampler`` (a valid-state sampler class is one).
+ValidStateSamplerAllocator = Callable[[Any], Any]
 
 
 @dataclass
@@ -107,6 +108,15 @@ class RRTConnectSettings(Settings):
     )
     goal_bias: float = param(
         0.05, "probability that goal_bias targets the other tree's root", low=0.0, high=1.0, suggestion="0.:.05:1."
+    )
+    uniform_rate: float = param(
+        0.1,
+        "probability that an iteration of goal_ball, neighbour_quality or valid_sampler targets a uniform sample "
+        "of the whole space instead, which keeps those policies probabilistically complete; 0: their targets "
+        "only (the strict rules)",
+        low=0.0,
+        high=1.0,
+        suggestion="0.:.05:1.",
     )
     min_quality: float = param(
         0.0, "lowest acceptance probability of neighbour_quality", low=0.0, high=1.0, suggestion="0.:.05:1."
@@ -187,15 +197,16 @@ class Extender:
     find_nearest: NearestFinder | None  # the nearest policy; None: the nearest node
     failures: dict[Tree, NodeFailures]  # recorded while a failure-counting nearest policy is on
 
-    def grow(self, tree: Tree, from_start: bool, target: Any, nearest: int | None = None) -> tuple[Grow, int]:
-        """Extend ``tree`` one step towards ``target``; return the outcome and the node added.
+    def grow(self, tree: Tree, from_start: bool, target: Any, nearest: int | None = None) -> tuple[Grow, int, float]:
+        """Extend ``tree`` one step towards ``target``.
 
-        The node extended is ``nearest`` when given, else the one the nearest policy
-        picks. Motions in the start tree are checked from the tree outwards; in the goal
-        tree they run from the new state into the tree, so the new state is checked
-        first (``checkMotion`` assumes its first state valid), exactly as OMPL does. A
-        motion in collision counts as a failed extension of the node (when the nearest
-        policy counts failures).
+        Returns the outcome, the node added (``NO_PARENT`` when trapped) and the distance
+        from the node extended to ``target`` (before the step). The node extended is
+        ``nearest`` when given, else the one the nearest policy picks. Motions in the start
+        tree are checked from the tree outwards; in the goal tree they run from the new
+        state into the tree, so the new state is checked first (``checkMotion`` assumes its
+        first state valid), exactly as OMPL does. A motion in collision counts as a failed
+        extension of the node (when the nearest policy counts failures).
         """
         points = self.points
         if nearest is None:
@@ -206,7 +217,7 @@ class Extender:
         reach = distance <= self.range
         new = target if reach else points.interpolate(near, target, self.range / distance)
         if not reach and self.step_may_stall and points.equal(near, new):
-            return Grow.TRAPPED, NO_PARENT
+            return Grow.TRAPPED, NO_PARENT, distance
 
         near_state, new_state = points.ompl_state(near, 0), points.ompl_state(new, 1)
         if from_start:
@@ -216,7 +227,7 @@ class Extender:
         if not valid:
             if self.find_nearest is not None:
                 self.failures[tree].record(nearest)
-            return Grow.TRAPPED, NO_PARENT
+            return Grow.TRAPPED, NO_PARENT, distance
 
         if self.intermediate_states:
             # States along the motion, ordered away from the tree's root.
@@ -225,7 +236,7 @@ class Extender:
                 added = tree.add(point, added)
         else:
             added = tree.add(new, nearest)
-        return (Grow.REACHED if reach else Grow.ADVANCED), added
+        return (Grow.REACHED if reach else Grow.ADVANCED), added, distance
 
 
 #: ``(grew_start, steps, collided)`` before the first iteration: as if the goal tree had
@@ -239,6 +250,10 @@ class BalancedRRTConnect(TreePlanner):
     Parameters are those of :class:`RRTConnectSettings`, through ``planner.params()``
     (OMPL string forms) or the camelCase accessors (``setMaxTreeSizeRatio``, ...).
 
+    Constructed as OMPL's ``og.RRTConnect``: ``BalancedRRTConnect(si, addIntermediateStates=False,
+    name=None)``; ``addIntermediateStates`` sets ``intermediate_states`` and, as stock, appends
+    ``Intermediate`` to the default name.
+
     Subclasses preset policies through ``POLICIES`` (parameter values set at
     construction) and ``VALID_STATE_SAMPLER`` (an allocator); their planner name is
     their class name. See :data:`PRESETS`.
@@ -246,19 +261,31 @@ class BalancedRRTConnect(TreePlanner):
 
     Settings = RRTConnectSettings
     Stats = RunStats
+    SPECS = PlannerSpecs(recognizedGoal=ob.GoalType.GOAL_SAMPLEABLE_REGION, directed=True)
+    SIGNATURE = "(si, addIntermediateStates=False, name=None)"
     POLICIES: ClassVar[dict[str, str]] = {}
-    VALID_STATE_SAMPLER: ClassVar[ValidStateSamplerAllocator | None] = None
+    VALID_STATE_SAMPLER: ClassVar[type | None] = None  # a valid-state sampler class
 
-    def __init__(self, si: ob.SpaceInformation, name: str | None = None) -> None:
+    def __init__(self, si: ob.SpaceInformation, addIntermediateStates: bool = False, name: str | None = None) -> None:  # noqa: N803 (OMPL's name)
+        if not isinstance(addIntermediateStates, (bool, np.bool_)):
+            self._refuse_argument(
+                "addIntermediateStates must be a bool (a planner name goes in name=...)", addIntermediateStates
+            )
+        if name is None and addIntermediateStates:
+            name = f"{type(self).__name__}Intermediate"
         super().__init__(si, name)
-        self.settings.update(self.POLICIES)
-        self._valid_state_sampler_allocator = type(self).VALID_STATE_SAMPLER
+        self.settings.update({**self.POLICIES, "intermediate_states": bool(addIntermediateStates)})
+        self._valid_state_sampler_allocator: ValidStateSamplerAllocator | None = type(self).VALID_STATE_SAMPLER
         self._valid_sampler: ob.ValidStateSampler | None = None
         # The trees and what the policies record per node: kept across solves until clear().
         self._start_tree: Tree | None = None
         self._goal_tree: Tree | None = None
         self._failures: dict[Tree, NodeFailures] = {}
         self._loop_state = _FIRST_LOOP_STATE
+        # For the planner data, as OMPL's: the nodes joined by the last solution (start tree,
+        # goal tree), and the least distance between the trees seen after a connect.
+        self._connection: tuple[int, int] | None = None
+        self._distance_between_trees = math.inf
 
     @property
     def draws_from_ompl_rng(self) -> bool:
@@ -291,13 +318,16 @@ class BalancedRRTConnect(TreePlanner):
                 "ompl.util.RNG.setSeed) or another sample_policy"
             )
 
-    _before_solve = _check_policies
+    def _before_solve(self, ptc: ob.PlannerTerminationCondition) -> None:
+        self._check_policies()
 
     def clear(self) -> None:
         super().clear()
         self._start_tree = self._goal_tree = None
         self._failures = {}
         self._loop_state = _FIRST_LOOP_STATE
+        self._connection = None
+        self._distance_between_trees = math.inf
 
     # -- solving -------------------------------------------------------------------
 
@@ -364,6 +394,7 @@ class BalancedRRTConnect(TreePlanner):
             self._failures,
         )
         sample = target_sampler(settings.sample_policy, self._sample_context(points, rng, counts, find_nearest))
+        nearest_is_euclidean = find_nearest is None
 
         status = ob.PlannerStatus.TIMEOUT
         progress = self.progress
@@ -391,18 +422,25 @@ class BalancedRRTConnect(TreePlanner):
             target, nearest = sample(grow_start)
             if target is None:
                 continue
-            grown, added = extender.grow(tree, grow_start, target, nearest)
+            grown, added, _ = extender.grow(tree, grow_start, target, nearest)
             if grown is Grow.TRAPPED:
                 continue
             # Connect: walk the other tree towards the state just added until trapped or there.
             target = tree.state(added)  # stays valid: only the other tree grows while connecting
-            connected, reached = extender.grow(other_tree, not grow_start, target)
+            connected, reached, gap = extender.grow(other_tree, not grow_start, target)
             steps += 1
             while connected is Grow.ADVANCED:
-                # The state just added is the other tree's nearest to the target (it is
-                # one range closer than any before), so the search is skipped.
-                connected, reached = extender.grow(other_tree, not grow_start, target, nearest=reached)
+                # Each further step extends the node just added (why not the nearest policy's
+                # choice: see policies.nearest_finder).
+                connected, reached, gap = extender.grow(other_tree, not grow_start, target, nearest=reached)
                 steps += 1
+            # OMPL's "approx goal distance": the other tree's nearest node to the state just
+            # added, after the connect (the node the last step extended, for the plain nearest).
+            if connected is Grow.REACHED:
+                gap = 0.0
+            elif not nearest_is_euclidean:
+                gap = other_tree.nearest(target)[1]
+            self._distance_between_trees = min(self._distance_between_trees, gap)
             collided = connected is Grow.TRAPPED
             if collided:
                 continue
@@ -442,6 +480,7 @@ class BalancedRRTConnect(TreePlanner):
             find_nearest,
             self.settings.goal_bias,
             self.settings.min_quality,
+            self.settings.uniform_rate,
         )
         if self.settings.sample_policy == "valid_sampler":
             si = self.getSpaceInformation()
@@ -464,7 +503,8 @@ class BalancedRRTConnect(TreePlanner):
         return self._valid_sampler
 
     def _path_points(self, start_node: int, goal_node: int) -> list[Any]:
-        """The points of the path start root -> start_node -> goal_node -> goal root."""
+        """The points of the path start root -> start_node -> goal_node -> goal root; records
+        the connection for the planner data."""
         start_tree, goal_tree = self._start_tree, self._goal_tree
         assert start_tree is not None and goal_tree is not None
         # The connecting step added the same state to both trees: step back one node
@@ -473,17 +513,29 @@ class BalancedRRTConnect(TreePlanner):
             start_node = start_tree.parent(start_node)
         else:
             goal_node = goal_tree.parent(goal_node)
+        self._connection = (start_node, goal_node)
         return [start_tree.state(node) for node in reversed(start_tree.branch(start_node))] + [
             goal_tree.state(node) for node in goal_tree.branch(goal_node)
         ]
 
+    def _graph_properties(self) -> dict[str, str]:
+        # As OMPL's RRTConnect, in C++'s default number format (inf until a connect was tried).
+        return {"approx goal distance REAL": f"{self._distance_between_trees:g}"}
+
     def _fill_planner_data(self, data: ob.PlannerData, points: Points, keep_alive: list[ob.State]) -> None:
-        """Start-tree vertices tag 1 (roots start vertices), goal-tree vertices tag 2 (roots
-        goal vertices); edges parent -> child in both trees."""
+        """OMPL's RRT-Connect graph: start-tree vertices tag 1 (roots start vertices) with edges
+        parent -> child, goal-tree vertices tag 2 (roots goal vertices) with edges child ->
+        parent, and the edge joining the trees when a solve connected them, so a solution is
+        a directed path from a start vertex to a goal vertex."""
         if self._start_tree is None or self._goal_tree is None:
             return
-        self._add_tree(data, points, self._start_tree, START_TAG, keep_alive)
-        self._add_tree(data, points, self._goal_tree, GOAL_TAG, keep_alive, roots_are_starts=False)
+        start = self._add_tree(data, points, self._start_tree, START_TAG, keep_alive)
+        goal = self._add_tree(
+            data, points, self._goal_tree, GOAL_TAG, keep_alive, roots_are_starts=False, towards_root=True
+        )
+        if self._connection is not None:
+            start_node, goal_node = self._connection
+            data.addEdge(start[start_node], goal[goal_node])
 
 
 # -- named presets ---------------------------------------------------------------------

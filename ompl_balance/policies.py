@@ -195,6 +195,15 @@ def nearest_finder(
     (:func:`nearest_not_exhausted`); ``exhaustion``: the least distance x
     :func:`exhaustion_scale` (``exhaustion_target``). ``failures`` holds each tree's
     :class:`NodeFailures`, which the planner records while such a policy is selected.
+
+    The planner asks the policy for each extension step and for the first step of each
+    connect. A connect's further steps extend the node the step before added, as
+    RRT-Connect's connect does. For ``euclidean`` and ``exhausted`` that node is the
+    policy's choice anyway: it is one ``range`` nearer the target than any node the step
+    before could choose from, and it never failed. ``exhaustion`` may prefer an older node
+    that failed about ``exhaustion_target`` times (its distance scaled by 0.9), among them
+    the node the step before extended; extending that one again lands on the state just
+    added, so a connect asking the policy could add that state over and over and never end.
     """
     if nearest_policy == "exhausted":
 
@@ -282,6 +291,7 @@ class SampleContext:
     find_nearest: NearestFinder | None = None  # the nearest policy (None: tree.nearest)
     goal_bias: float = 0.05
     min_quality: float = 0.0
+    uniform_rate: float = 0.0  # goal_ball, neighbour_quality, valid_sampler: probability of a uniform target
     valid_sampler: ob.ValidStateSampler | None = None
     checker: Any = None  # the counting validity checker, to attribute checks to the sampler
     scratch: ob.State | None = None  # an OMPL state the valid-state sampler writes into
@@ -294,16 +304,23 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
     ``goal_bias``          with probability ``goal_bias`` the other tree's first root (the goal
                            when growing the start tree, the start when growing the goal tree);
     ``goal_ball``          a uniform sample no farther from the other tree's first root than
-                           start and goal are apart (the lab's "control chosen");
+                           start and goal are apart ("control chosen");
     ``neighbour_quality``  a uniform sample kept with probability :func:`node_quality` of the
-                           node the nearest policy picks for it;
+                           node ``context.find_nearest`` (the nearest policy) picks for it;
     ``valid_sampler``      a sample of ``context.valid_sampler``, or a uniform sample when it
                            finds none (free space has no state near an obstacle).
 
-    The rejecting policies give up the iteration after :data:`SAMPLE_ATTEMPTS` draws.
+    ``goal_ball``, ``neighbour_quality`` and ``valid_sampler`` never target some states
+    (those outside the ball; those whose nearest node has quality 0 under ``min_quality``
+    0, such as the costliest node of a tree; those far from obstacles), which can leave a
+    problem unsolved for ever. With probability ``context.uniform_rate`` their iteration
+    targets a uniform sample instead, which makes them probabilistically complete as
+    RRT-Connect is. The rejecting policies give up the iteration after
+    :data:`SAMPLE_ATTEMPTS` draws.
     """
     points, start_tree, goal_tree = context.points, context.start_tree, context.goal_tree
     uniform, distance, random, counts = points.sample, points.distance, context.random, context.counts
+    uniform_rate = context.uniform_rate
     if sample_policy == "uniform":
         return lambda grow_start: (uniform(), None)
     if sample_policy == "goal_bias":
@@ -318,6 +335,8 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
     if sample_policy == "goal_ball":
 
         def in_goal_ball(grow_start: bool) -> tuple[Any, int | None]:
+            if uniform_rate > 0.0 and random() < uniform_rate:
+                return uniform(), None
             centre = (goal_tree if grow_start else start_tree).state(0)
             radius = distance(start_tree.state(0), goal_tree.state(0))
             for _ in range(SAMPLE_ATTEMPTS):
@@ -333,6 +352,8 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
         min_quality, find_nearest = context.min_quality, context.find_nearest
 
         def quality_accepted(grow_start: bool) -> tuple[Any, int | None]:
+            if uniform_rate > 0.0 and random() < uniform_rate:
+                return uniform(), None
             tree = start_tree if grow_start else goal_tree
             start, goal = start_tree.state(0), goal_tree.state(0)
             tree_costs = costs[tree]
@@ -353,6 +374,8 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
             raise ValueError("sample_policy valid_sampler needs a valid-state sampler, the checker and a scratch state")
 
         def from_valid_sampler(grow_start: bool) -> tuple[Any, int | None]:
+            if uniform_rate > 0.0 and random() < uniform_rate:
+                return uniform(), None
             before = checker.counters()["states_checked"]
             found = sampler.sample(state)
             counts.checks += checker.counters()["states_checked"] - before

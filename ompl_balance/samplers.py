@@ -14,9 +14,10 @@ takes one::
     OMPL's ``BridgeTestValidStateSampler``: an invalid uniform state and an invalid
     Gaussian neighbour of it; their midpoint is the sample when it is valid.
 :class:`PassageSampler`
-    the lab's passage sampler: a valid uniform state is the sample when the number of
-    its ``neighbours`` Gaussian neighbours that collide lies in
-    ``[min_colliding, max_colliding]`` (default: some but not all collide).
+    the passage sampler of the TU Berlin lab report "RRT Extensions" (2020): a valid
+    uniform state is the sample when the number of its ``neighbours`` Gaussian
+    neighbours that collide lies in ``[min_colliding, max_colliding]`` (default: some
+    but not all collide).
 
 OMPL's Python bindings do not expose the first two. All three:
 
@@ -172,7 +173,8 @@ class BridgeTestValidStateSampler(_NearObstacleSampler):
 
 
 class PassageSampler(_NearObstacleSampler):
-    """The lab's passage sampler: a valid uniform state with some, not all, neighbours colliding.
+    """The passage sampler of the lab report "RRT Extensions" (2020): a valid uniform state with
+    some, not all, neighbours colliding.
 
     Parameters
     ----------
@@ -183,7 +185,7 @@ class PassageSampler(_NearObstacleSampler):
         ("some but not all"). Neighbours stop being checked once the count can no
         longer end in the range.
     stddev_fraction: the neighbours' standard deviation as a fraction of the space's
-        maximum extent (the lab used 0.05).
+        maximum extent (the report's 0.05).
     """
 
     Settings = PassageSettings

@@ -92,17 +92,11 @@ class PlannerEntry:
 
 
 def configured(planner_class: type, balance_tree_sizes: bool | None = None) -> PlannerFactory:
-    """A factory for ``planner_class`` with 2denvs.cpp's settings: range 10.
-
-    The range is ``setRange`` for the RRT-Connect family (as OMPL's) and
-    ``setMaxConnectionDistance`` (``eta``, the same step length) for ``BallRadiusRRTstar``.
-    """
+    """A factory for ``planner_class`` with 2denvs.cpp's settings: range 10 (``setRange``)."""
 
     def make(si: ob.SpaceInformation) -> ob.Planner:
         planner = planner_class(si)
-        set_range = getattr(planner, "setRange", None) or getattr(planner, "setMaxConnectionDistance", None)
-        if set_range is not None:
-            set_range(RANGE)
+        planner.setRange(RANGE)
         if balance_tree_sizes is not None:
             planner.setBalanceTreeSizes(balance_tree_sizes)
         return planner

@@ -9,13 +9,17 @@ import pytest
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
-from scipy.stats import binom
+from scipy.stats import binom, binomtest
 
 from ompl_balance.cli import main
 from ompl_balance.gamma import (
+    STOP_CHECK_EVERY,
+    EstimateInterruptedError,
     ball_radius_constant,
+    clopper_pearson,
     estimate_ball_radius_constant,
     estimate_free_measure,
+    ompl_ball_radius_constant,
     ompl_rewire_factor,
     rewire_radius,
     unit_ball_volume,
@@ -173,6 +177,25 @@ def test_monte_carlo_estimate_rejects_bad_arguments():
         estimate_free_measure(si, grid=np.zeros((3, 3)))
 
 
+@pytest.mark.parametrize("samples", [1, 2, 17, 100, 5000])
+def test_clopper_pearson_is_scipys_exact_interval(samples):
+    for free in sorted({0, 1, samples // 3, samples // 2, samples - 1, samples}):
+        expected = binomtest(free, samples).proportion_ci(confidence_level=0.95, method="exact")
+        low, high = clopper_pearson(free, samples, 0.95)
+        assert low == pytest.approx(expected.low, abs=1e-10) and high == pytest.approx(expected.high, abs=1e-10)
+
+
+def test_a_stopped_estimate_uses_the_samples_drawn_so_far():
+    si, _grid, _ss = _checkerboard_setup()
+    asked = []
+    free = estimate_free_measure(si, samples=5000, rng=2, stop=lambda: asked.append(1) or len(asked) > 3)
+    assert free.samples == 3 * STOP_CHECK_EVERY and len(asked) == 4
+    same = estimate_free_measure(si, samples=3 * STOP_CHECK_EVERY, rng=2)  # the same draws, unstopped
+    assert (free.measure, free.low, free.high) == (same.measure, same.low, same.high)
+    with pytest.raises(EstimateInterruptedError, match="before the first sample"):
+        estimate_free_measure(si, samples=5000, rng=2, stop=lambda: True)
+
+
 def test_estimated_constant_uses_the_upper_end_of_the_interval():
     si, grid, _ss = _checkerboard_setup()
     free = estimate_free_measure(si, samples=1000, rng=3)
@@ -204,6 +227,19 @@ def test_ompl_rewire_factor_gives_the_same_radius(se2, gamma):
     for n in (2, 10, 100, 1000, 10_000, 1_000_000):
         assert _ompl_radius(n, d, measure, factor, eta) == pytest.approx(rewire_radius(n, d, gamma, eta), rel=1e-12)
         assert _ompl_radius(n, d, measure, factor, math.inf) == pytest.approx(rewire_radius(n, d, gamma), rel=1e-12)
+
+
+@pytest.mark.parametrize("se2", [False, True])
+@pytest.mark.parametrize("factor", [1.0, 1.1, 1.7])
+def test_ompl_ball_radius_constant_is_the_gamma_of_ompls_schedule(se2, factor):
+    si = rooms_problem(se2=se2).setup().getSpaceInformation()
+    d, measure = si.getStateDimension(), si.getSpaceMeasure()
+    gamma = ompl_ball_radius_constant(si, factor)
+    assert ompl_rewire_factor(si, gamma) == pytest.approx(factor, rel=1e-12)
+    for n in (2, 100, 10_000, 1_000_000):
+        assert rewire_radius(n, d, gamma, 4.0) == pytest.approx(_ompl_radius(n, d, measure, factor, 4.0), rel=1e-12)
+    with pytest.raises(ValueError, match="rewire_factor"):
+        ompl_ball_radius_constant(si, 0.0)
 
 
 def test_ompl_default_factor_differs_by_the_measure_ratio_and_a_power_of_two():

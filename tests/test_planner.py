@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
 import time
 
 import pytest
@@ -14,8 +15,8 @@ from ompl import tools as ot
 from ompl import util as ou
 from pathcheck import assert_valid_solution
 
-from ompl_balance import BalancedRRTConnect, balance_choice, read_work, tree_size_ratio
-from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, get_problem
+from ompl_balance import BalancedRRTConnect, BallRadiusRRTstar, balance_choice, read_work, tree_size_ratio
+from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, Problem, get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
 
@@ -230,12 +231,23 @@ def test_solve_called_directly_with_seconds():
     assert pdef.getSolutionPath().getStateCount() >= 2
 
 
-@pytest.mark.parametrize("bad", [0, -1.0, float("nan"), float("inf")])
-def test_solve_rejects_time_limits_that_are_not_positive(bad):
+@pytest.mark.parametrize("limit", [0, 0.0, -1.0])
+def test_solve_with_no_time_left_returns_at_once_as_stock(limit):
+    # og.RRTConnect(si).solve(0.0) returns TIMEOUT without an iteration; so does ours
     ss = get_problem("open").setup()
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     planner.setProblemDefinition(ss.getProblemDefinition())
-    with pytest.raises(ValueError, match="positive"):
+    planner.setup()
+    assert planner.solve(limit) == ob.PlannerStatus.TIMEOUT
+    assert planner.stats.iterations == 0
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
+def test_solve_rejects_time_limits_that_are_not_finite(bad):
+    ss = get_problem("open").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setProblemDefinition(ss.getProblemDefinition())
+    with pytest.raises(ValueError, match="finite number of seconds"):
         planner.solve(bad)
 
 
@@ -259,7 +271,7 @@ def test_ompl_benchmark_runs_and_logs_our_planner(tmp_path):
 def test_simple_setup_get_planner_data_does_not_crash_and_plannerdata_has_both_trees():
     _problem, ss, planner, _status = solve_problem("bug_trap")
     data = ob.PlannerData(ss.getSpaceInformation())
-    ss.getPlannerData(data)  # would abort the process if the planner defined getPlannerData
+    ss.getPlannerData(data)  # C++'s call reaches OMPL's Planner::getPlannerData: empty, no abort
     assert data.numVertices() == 0
     data = planner.plannerData()
     stats = planner.stats
@@ -267,10 +279,13 @@ def test_simple_setup_get_planner_data_does_not_crash_and_plannerdata_has_both_t
     tags = [data.getVertex(i).getTag() for i in range(data.numVertices())]
     assert tags.count(1) == stats.start_tree_size and tags.count(2) == stats.goal_tree_size
     assert data.numStartVertices() == 1 and data.numGoalVertices() == 1
-    assert data.numEdges() == data.numVertices() - 2  # every vertex but the two roots has a parent edge
-    # edges run parent -> child: a start root only has outgoing edges
-    start_root = data.getStartIndex(0)
+    # every vertex but the two roots has its tree edge, plus the edge joining the trees
+    assert data.numEdges() == data.numVertices() - 1
+    # start-tree edges run parent -> child, goal-tree edges child -> parent: both roots are ends
+    start_root, goal_root = data.getStartIndex(0), data.getGoalIndex(0)
     assert data.getIncomingEdges(start_root) == [] and data.getEdges(start_root)
+    assert data.getEdges(goal_root) == [] and data.getIncomingEdges(goal_root)
+    assert data.properties["approx goal distance REAL"] == "0"  # solved: the trees met
 
 
 # -- statuses -------------------------------------------------------------------------
@@ -403,7 +418,7 @@ ROUND_TRIPS = {
     "balance_tree_sizes": ("0", "0"),
     "max_tree_size_ratio": ("2.5", "2.5"),
     "seed": ("42", "42"),
-    # the classroom-variant policies (issue #6; tests/test_variants.py)
+    # the classroom-variant policies (tests/test_variants.py)
     "swap_policy": ("on_collision", "on_collision"),
     "swap_steps": ("7", "7"),
     "nearest_policy": ("exhaustion", "exhaustion"),
@@ -412,6 +427,7 @@ ROUND_TRIPS = {
     "sample_policy": ("goal_ball", "goal_ball"),
     "goal_bias": ("0.25", "0.25"),
     "min_quality": ("0.1", "0.1"),
+    "uniform_rate": ("0.2", "0.2"),
 }
 
 
@@ -489,3 +505,47 @@ def test_fixed_seed_parameter_repeats_the_path_in_one_process():
         path = ss.getSolutionPath()
         paths.append([path.getState(i)[j] for i in range(path.getStateCount()) for j in range(2)])
     assert paths[0] == paths[1]
+
+
+# -- progress properties ----------------------------------------------------------------------
+
+
+#: A wall across the square: RRT-Connect plans until the time limit.
+WALL = Problem("wall", "a wall across the square", ((0.45, 0.0, 0.55, 1.0),), (0.1, 0.5), (0.9, 0.5))
+
+
+@pytest.mark.parametrize("planner_class", [BalancedRRTConnect, BallRadiusRRTstar])
+def test_progress_properties_read_live_from_another_thread(planner_class):
+    # both plan until the time limit: RRT-Connect cannot pass the wall, RRT* keeps improving
+    ss = (WALL if planner_class is BalancedRRTConnect else get_problem("maze")).setup()
+    planner = planner_class(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    properties = planner.progressProperties()
+    trees = (
+        ["start tree size INTEGER", "goal tree size INTEGER"]
+        if planner_class is BalancedRRTConnect
+        else ["tree size INTEGER"]
+    )
+    assert list(properties) == ["iterations INTEGER", "best cost REAL", *trees]
+    samples, done = [], threading.Event()
+
+    def sample() -> None:
+        while not done.is_set():
+            samples.append({name: value() for name, value in properties.items()})
+            time.sleep(0.001)
+
+    sampler = threading.Thread(target=sample)
+    sampler.start()
+    ss.solve(0.5)
+    done.set()
+    sampler.join()
+    final = {name: value() for name, value in planner.progressProperties().items()}
+    assert int(final["iterations INTEGER"]) == planner.stats.iterations
+    assert len({sample["iterations INTEGER"] for sample in samples}) >= 3  # seen while it ran
+    for name in ["iterations INTEGER", *trees]:
+        values = [int(s[name]) for s in samples]
+        assert values == sorted(values) and values[-1] <= int(final[name])
+    costs = [float(s["best cost REAL"]) for s in samples]
+    assert all(later <= earlier for earlier, later in itertools.pairwise(costs))
+    if planner.stats.status == "Exact solution":
+        assert float(final["best cost REAL"]) == pytest.approx(ss.getSolutionPath().length())

@@ -5,7 +5,8 @@ import pytest
 from fresh_process import run_with_seed
 from ompl import base as ob
 
-from ompl_balance.core.trees import NO_PARENT, ArrayTree, StateTree
+from ompl_balance.core import trees
+from ompl_balance.core.trees import COMPILED_SCANS_FROM, NO_PARENT, ArrayTree, StateTree, _squared_distances, load_scans
 
 
 @pytest.mark.parametrize(("dim", "offset", "scale"), [(2, 0.0, 1.0), (7, 0.0, 1.0), (3, 1e6, 1e-3), (7, -50.0, 1e-6)])
@@ -49,25 +50,72 @@ def test_array_tree_nearest_of_an_empty_tree_is_refused():
         ArrayTree(2).nearest(np.zeros(2))
 
 
-def test_import_stays_quick():
-    """``import ompl_balance`` loads neither numba nor the compiled scans; a planner's setup() does."""
+def test_kernels_load_only_where_a_tree_needs_them():
+    """``import ompl_balance``, a planner's setup() and a solve whose trees stay small load
+    neither numba nor the compiled scans; a tree reaching COMPILED_SCANS_FROM nodes starts
+    loading them in the background, and scans with them once they are there."""
     script = (
-        "import sys\n"
+        "import sys, time\n"
+        "import numpy as np\n"
         "import ompl_balance\n"
         "from ompl import base as ob, util as ou\n"
+        "from ompl_balance.core import trees\n"
         "ou.setLogLevel(ou.LOG_WARN)\n"
-        "print('numba' in sys.modules, 'ompl_balance.core.scans' in sys.modules)\n"
-        "space = ob.RealVectorStateSpace(2)\n"
-        "space.setBounds(0.0, 1.0)\n"
-        "si = ob.SpaceInformation(space)\n"
-        "si.setStateValidityChecker(lambda state: True)\n"
-        "si.setup()\n"
-        "planner = ompl_balance.BalancedRRTConnect(si)\n"
-        "planner.setProblemDefinition(ob.ProblemDefinition(si))\n"
-        "planner.setup()\n"
-        "print('ompl_balance.core.scans' in sys.modules)\n"
+        "loaded = lambda: ('numba' in sys.modules, 'ompl_balance.core.scans' in sys.modules)\n"
+        "print(*loaded())\n"
+        "problem = ompl_balance.get_problem('narrow_gap')\n"
+        "ss = problem.setup()\n"
+        "planner = ompl_balance.BalancedRRTConnect(ss.getSpaceInformation())\n"
+        "ss.setPlanner(planner)\n"
+        "ss.setup()\n"
+        "print(*loaded())\n"
+        "ss.solve(10.0)\n"
+        "print(planner.stats.start_tree_size < trees.COMPILED_SCANS_FROM, *loaded())\n"
+        "tree = trees.ArrayTree(2)\n"
+        "for point in np.random.default_rng(0).random((trees.COMPILED_SCANS_FROM, 2)):\n"
+        "    tree.add(point)\n"
+        "answer = tree.nearest(np.array([0.5, 0.5]))\n"
+        "trees._LOADER.finish()\n"
+        "print('ompl_balance.core.scans' in sys.modules, tree.nearest(np.array([0.5, 0.5])) == answer)\n"
     )
-    assert run_with_seed(script, 0).split() == ["False", "False", "True"]
+    assert run_with_seed(script, 0).split() == ["False"] * 2 + ["False"] * 2 + ["True", "False", "False"] + [
+        "True",
+        "True",
+    ]
+
+
+@pytest.mark.parametrize("dim", range(1, 10))
+def test_numpy_and_compiled_scans_agree_to_the_last_bit(dim):
+    rng = np.random.default_rng(dim)
+    scans = load_scans()
+    for scale in (1.0, 1e6, 1e-6):
+        states = np.ascontiguousarray(rng.normal(size=(300, dim)) * scale)
+        for query in rng.normal(size=(30, dim)) * scale:
+            squared = _squared_distances(states, query)
+            index, nearest_squared = scans.nearest(states, len(states), query)
+            assert index == int(squared.argmin()) and nearest_squared == squared[index]
+            radius = float(np.sqrt(np.quantile(squared, 0.1)))
+            indices, distances = np.empty(300, dtype=np.int64), np.empty(300)
+            count = scans.within(states, len(states), query, radius, indices, distances)
+            inside = np.flatnonzero(squared <= radius * radius)
+            assert np.array_equal(indices[:count], inside)
+            assert np.array_equal(distances[:count], np.sqrt(squared[inside]))
+
+
+def test_array_tree_answers_the_same_with_either_scan(monkeypatch):
+    rng = np.random.default_rng(5)
+    tree = ArrayTree(3)
+    for point in rng.random((COMPILED_SCANS_FROM + 500, 3)):
+        tree.add(point)
+    load_scans()
+    queries = rng.random((20, 3))
+
+    def answers():
+        return [(tree.nearest(query), *(a.tolist() for a in tree.near(query, 0.2))) for query in queries]
+
+    compiled = answers()
+    monkeypatch.setattr(trees, "COMPILED_SCANS_FROM", 10**9)  # numpy scans whatever the size
+    assert answers() == compiled
 
 
 def test_links_roots_and_branches():

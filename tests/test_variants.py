@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -13,20 +14,28 @@ from ompl import util as ou
 from pathcheck import assert_valid_solution
 
 from ompl_balance import planners
+from ompl_balance.core.trees import ArrayTree
 from ompl_balance.planners import PRESETS, BalancedRRTConnect, Extender, GaussianPassageRRTConnect, Grow
 from ompl_balance.policies import (
+    NEAREST_POLICIES,
+    SAMPLE_ATTEMPTS,
     SAMPLE_POLICIES,
     SWAP_POLICIES,
+    NodeFailures,
+    SampleContext,
+    SamplerCounts,
     SwapCause,
     balance_choice,
     exhaustion_scale,
     nearest_by_exhaustion,
+    nearest_finder,
     nearest_not_exhausted,
     node_quality,
+    target_sampler,
     tree_chooser,
 )
 from ompl_balance.samplers import GaussianValidStateSampler
-from ompl_balance.worlds.boxes import get_problem
+from ompl_balance.worlds.boxes import Problem, get_problem
 
 ALTERNATE, BALANCE, STEPS, COLLISION = SwapCause
 
@@ -201,9 +210,9 @@ def extension_targets(events):
     return targets
 
 
-def test_goal_ball_never_targets_farther_from_the_goal_than_the_start(monkeypatch):
+def test_strict_goal_ball_never_targets_farther_from_the_goal_than_the_start(monkeypatch):
     problem = get_problem("bug_trap")
-    _ss, planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_ball")
+    _ss, planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_ball", uniform_rate=0.0)
     start, goal = np.array(problem.start), np.array(problem.goal)
     radius = np.linalg.norm(goal - start)
     targets = extension_targets(events)
@@ -423,17 +432,234 @@ def test_balance_tree_sizes_and_swap_policy_are_independent_in_any_order():
     assert planners_made[0]["swap_policy"] == "on_collision" and planners_made[0]["balance_tree_sizes"] == "1"
 
 
-def test_a_presets_policy_changes_only_through_its_own_parameter():
-    planner = PRESETS["CollisionSwapRRTConnect"](get_problem("open").setup().getSpaceInformation())
-    assert planner.getBalanceTreeSizes() is False and planner.getSwapPolicy() == "on_collision"
+#: A value other than the default for every parameter of BalancedRRTConnect.
+OTHER_VALUES = {
+    "range": "0.3",
+    "intermediate_states": "1",
+    "balance_tree_sizes": "0",
+    "max_tree_size_ratio": "0.5",
+    "swap_policy": "balance_steps",
+    "swap_steps": "4",
+    "nearest_policy": "exhaustion",
+    "exhausted_after": "3",
+    "exhaustion_target": "2",
+    "sample_policy": "goal_ball",
+    "goal_bias": "0.3",
+    "min_quality": "0.2",
+    "uniform_rate": "0.4",
+    "seed": "9",
+}
+
+
+def test_parameters_in_any_order_make_the_same_planner():
+    si = get_problem("open").setup().getSpaceInformation()
+    assert set(OTHER_VALUES) == set(BalancedRRTConnect(si).params().getParamNames())
+    rng = np.random.default_rng(0)
+    names = list(OTHER_VALUES)
+    made = set()
+    for _ in range(30):
+        order = rng.permutation(names)
+        subset = order[: rng.integers(1, len(names) + 1)]
+        planner = BalancedRRTConnect(si)
+        assert planner.params().setParams({name: OTHER_VALUES[name] for name in subset})
+        expected = {**BalancedRRTConnect(si).params().getParams(), **{name: OTHER_VALUES[name] for name in subset}}
+        assert planner.params().getParams() == expected
+        made.add(tuple(sorted(subset)))
+    assert len(made) > 20
+    for order in itertools.islice(itertools.permutations(names), 0, 5000, 250):  # one at a time, any order
+        planner = BalancedRRTConnect(si)
+        for name in order:
+            assert planner.params().setParam(name, OTHER_VALUES[name])
+        assert planner.params().getParams() == {name: OTHER_VALUES[name] for name in names}
+
+
+@pytest.mark.parametrize("preset", LAB_PRESETS)
+def test_a_presets_policy_changes_only_through_its_own_parameters(preset):
+    si = get_problem("open").setup().getSpaceInformation()
+    policy = PRESETS[preset].POLICIES
+    for name, value in OTHER_VALUES.items():
+        if name in policy:
+            continue
+        planner = PRESETS[preset](si)
+        assert planner.params().setParam(name, value)
+        for policy_name, policy_value in policy.items():
+            assert planner.params().getParam(policy_name) == policy_value, (name, policy_name)
+    planner = PRESETS["CollisionSwapRRTConnect"](si)
     assert planner.params().setParam("balance_tree_sizes", "1")
     assert planner.getSwapPolicy() == "on_collision"  # balancing joins the preset's rule, not replaces it
 
 
-def test_valid_sampler_with_a_fixed_seed_is_refused_at_setup():
-    ss = get_problem("open").setup()
-    planner = BalancedRRTConnect(ss.getSpaceInformation())
-    assert planner.params().setParams({"sample_policy": "valid_sampler", "seed": "3"})
+# -- connect steps and the nearest policy ---------------------------------------------------
+
+
+@pytest.mark.parametrize("policy", NEAREST_POLICIES)
+def test_connect_steps_after_the_first_extend_the_node_just_added(monkeypatch, policy):
+    # a short range: connects take many steps
+    _ss, _planner, events = traced_run(monkeypatch, "maze", nearest_policy=policy, balance_tree_sizes=0, range=0.03)
+    firsts, furthers = [], []  # connect steps: was the node handed over (no search)?
+    current, in_connect = None, False
+    for event in events:
+        if event[0] == "choose":
+            current, in_connect = event[4], False
+        elif event[1] != current:  # a connect step: the other tree grows
+            (furthers if in_connect else firsts).append(event[3])
+            in_connect = True
+        else:
+            in_connect = False
+    assert len(furthers) > 10 and all(furthers)
+    assert firsts and not any(firsts)  # the first step asks the policy
+
+
+def test_exhaustion_can_prefer_an_older_failed_node_to_the_node_just_added():
+    """Why a connect's further steps do not ask ``exhaustion``: it can pick the node the step
+    before extended, whose step would land on the state just added, again and again."""
+    tree = ArrayTree(2)
+    old = tree.add(np.array([0.0, 0.0]))
+    failures = {tree: NodeFailures()}
+    for _ in range(5):
+        failures[tree].record(old)
+    find = nearest_finder("exhaustion", failures, exhaustion_target=5)
+    target = np.array([1.0, 0.0])
+    assert find(tree, target)[0] == old
+    fresh = tree.add(np.array([0.05, 0.0]), old)  # the connect's step from ``old`` towards the target
+    assert tree.nearest(target)[0] == fresh
+    assert find(tree, target)[0] == old  # 1.0 x 0.9 < 0.95 x 1.0: ``old`` again, the same step again
+
+
+def test_neighbour_quality_asks_the_finder_it_is_given():
+    """The nearest policy reaches neighbour_quality through its context, nothing else."""
+    tree, other = ArrayTree(2), ArrayTree(2)
+    tree.add(np.array([0.1, 0.1]))
+    other.add(np.array([0.9, 0.9]))
+    asked = []
+
+    def finder(searched, point):
+        asked.append(searched is tree)
+        return 0, float(np.linalg.norm(point - searched.state(0)))
+
+    class Uniform:
+        def __init__(self):
+            self.rng = np.random.default_rng(1)
+
+        def sample(self):
+            return self.rng.random(2)
+
+        @staticmethod
+        def distance(a, b):
+            return float(np.linalg.norm(a - b))
+
+    context = SampleContext(Uniform(), tree, other, np.random.default_rng(2).random, SamplerCounts(), finder)
+    sample = target_sampler("neighbour_quality", context)
+    for _ in range(20):
+        target, nearest = sample(True)
+        assert target is not None and nearest == 0
+    assert len(asked) == 20 and all(asked)
+
+
+# -- complete by default ---------------------------------------------------------------------
+
+
+class _FarSampler:
+    """Points whose uniform samples are all far outside any goal ball: (0, 0) and (5, 5) marks."""
+
+    def __init__(self):
+        self.far = np.array([5.0, 5.0])
+
+    def sample(self):
+        return self.far
+
+    @staticmethod
+    def distance(a, b):
+        return float(np.linalg.norm(a - b))
+
+
+@pytest.mark.parametrize("rate", [0.0, 0.1, 0.5])
+def test_goal_ball_takes_a_uniform_target_at_the_uniform_rate(rate):
+    start, goal = ArrayTree(2), ArrayTree(2)
+    start.add(np.array([0.0, 0.0]))
+    goal.add(np.array([1.0, 0.0]))
+    counts = SamplerCounts()
+    context = SampleContext(_FarSampler(), start, goal, np.random.default_rng(4).random, counts, uniform_rate=rate)
+    sample = target_sampler("goal_ball", context)
+    n = 2000
+    uniform = sum(sample(True)[0] is not None for _ in range(n))  # the ball rejects every far point
+    assert abs(uniform / n - rate) <= 4 * math.sqrt(rate * (1 - rate) / n)
+    assert counts.rejections == (n - uniform) * SAMPLE_ATTEMPTS
+
+
+#: Start and goal each in a pocket that opens away from the other: every way out of a pocket
+#: leaves the ball around the other root whose radius is the start-goal distance (0.3).
+TWIN_POCKETS = Problem(
+    "twin_pockets",
+    "start and goal in pockets opening away from each other",
+    (
+        (0.22, 0.60, 0.45, 0.62),
+        (0.22, 0.38, 0.45, 0.40),
+        (0.43, 0.38, 0.45, 0.62),
+        (0.55, 0.60, 0.78, 0.62),
+        (0.55, 0.38, 0.78, 0.40),
+        (0.55, 0.38, 0.57, 0.62),
+    ),
+    (0.35, 0.5),
+    (0.65, 0.5),
+)
+
+
+def test_control_chosen_solves_what_stock_solves_and_the_strict_rule_cannot():
+    ss = TWIN_POCKETS.setup()
+    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    for seed in (1, 2, 3):
+        ss = TWIN_POCKETS.setup()
+        planner = PRESETS["ControlChosenRRTConnect"](ss.getSpaceInformation())
+        planner.setSeed(seed)
+        ss.setPlanner(planner)
+        assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+        start = ss.getSpaceInformation().allocState()
+        start[0], start[1] = TWIN_POCKETS.start
+        assert_valid_solution(ss, TWIN_POCKETS.world(), [start], ss.getGoal().isSatisfied)
+    # the strict rule keeps each tree inside the ball around the other root: never solved
+    ss = TWIN_POCKETS.setup()
+    planner = PRESETS["ControlChosenRRTConnect"](ss.getSpaceInformation())
+    planner.setUniformRate(0.0)
+    planner.setSeed(1)
     ss.setPlanner(planner)
-    with pytest.raises(ValueError, match=r"valid_sampler.*seed"):
-        ss.setup()
+    iterations = iter(range(3000))
+    assert ss.solve(ob.PlannerTerminationCondition(lambda: next(iterations, None) is None)) == ob.PlannerStatus.TIMEOUT
+    radius = math.dist(TWIN_POCKETS.start, TWIN_POCKETS.goal)
+    for tree, centre in ((planner._start_tree, TWIN_POCKETS.goal), (planner._goal_tree, TWIN_POCKETS.start)):
+        assert len(tree) > 50
+        assert np.all(np.linalg.norm(tree.states - np.array(centre), axis=1) <= radius + 1e-9)
+
+
+def so2_setup() -> og.SimpleSetup:
+    """A circle with an obstacle between 0.5 and 1.0 rad; start 0, goal 1.5: the way goes round."""
+    space = ob.SO2StateSpace()
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda state: not 0.5 <= state.value <= 1.0)
+    start, goal = space.allocState(), space.allocState()
+    start.value, goal.value = 0.0, 1.5
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
+@pytest.mark.parametrize("preset", ["GaussianPassageRRTConnect", "NeighbourCostRRTConnect"])
+def test_presets_solve_the_circle_in_every_run_and_their_strict_rules_do_not(preset):
+    """Near obstacles only (the passage sampler), or never from the costliest node (neighbour
+    quality with min_quality 0): the far side of the circle is never targeted."""
+    ss = so2_setup()
+    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+    assert ss.solve(2.0) == ob.PlannerStatus.EXACT_SOLUTION
+    for _ in range(5):
+        ss = so2_setup()
+        planner = PRESETS[preset](ss.getSpaceInformation())
+        ss.setPlanner(planner)
+        assert ss.solve(2.0) == ob.PlannerStatus.EXACT_SOLUTION
+        path = ss.getSolutionPath()
+        assert path.check() and all(not 0.5 <= path.getState(i).value <= 1.0 for i in range(path.getStateCount()))
+    ss = so2_setup()
+    planner = PRESETS[preset](ss.getSpaceInformation())
+    planner.setUniformRate(0.0)
+    ss.setPlanner(planner)
+    iterations = iter(range(500))
+    assert ss.solve(ob.PlannerTerminationCondition(lambda: next(iterations, None) is None)) == ob.PlannerStatus.TIMEOUT

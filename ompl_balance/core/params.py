@@ -28,6 +28,7 @@ import math
 import sys
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import MISSING, Field, dataclass, field, fields
+from functools import partial
 from typing import IO, Any, ClassVar
 
 from ompl import util as ou
@@ -239,7 +240,13 @@ def add_accessors(cls: type, settings: type[Settings], attribute: str = "setting
 
 
 class GenericParam:
-    """One parameter of a :class:`ParamSet`, as OMPL's ``ompl::base::GenericParam``."""
+    """One parameter of a :class:`ParamSet`, as OMPL's ``ompl::base::GenericParam``.
+
+    ``getName``/``setName``, ``getValue`` (the value in OMPL's string form), ``setValue``
+    (from a string; ``False`` and an OMPL error when refused), ``getRangeSuggestion``/
+    ``setRangeSuggestion``. A parameter of a :class:`Settings` table also knows its table
+    (``settings``, ``field``), so that :meth:`ParamSet.setParams` can set several at once.
+    """
 
     def __init__(
         self,
@@ -248,28 +255,37 @@ class GenericParam:
         getter: Callable[[], Any],
         parse: Callable[[str], Any],
         range_suggestion: str,
+        settings: Settings | None = None,
     ) -> None:
         self._name = name
-        self._setter, self._getter, self._parse = setter, getter, parse
+        self._setter, self._getter, self.parse = setter, getter, parse
         self._range_suggestion = range_suggestion
+        self.settings, self.field = settings, name
 
     def getName(self) -> str:  # noqa: N802 (OMPL's names)
         return self._name
 
+    def setName(self, name: str) -> None:  # noqa: N802
+        self._name = name
+
     def getValue(self) -> str:  # noqa: N802
-        """The current value in OMPL's string form."""
+        """The current value in OMPL's string form (booleans ``0``/``1``)."""
         return _format(self._getter())
 
     def setValue(self, value: Any) -> bool:  # noqa: N802
         """Set from the string form; ``False`` (and an OMPL error naming what is accepted) if refused."""
         text = _format(value)
         try:
-            self._setter(self._parse(text))
+            self._setter(self.parse(text))
         except ValueError as error:
-            accepted = f" (range suggestion '{self._range_suggestion}')" if self._range_suggestion else ""
-            ou.OMPL_ERROR(f"Invalid value '{text}' for parameter '{self._name}': {error}{accepted}")
+            self.refused(text, error)
             return False
         return True
+
+    def refused(self, text: str, error: Exception) -> None:
+        """Log OMPL's error for a refused value ``text``."""
+        accepted = f" (range suggestion '{self._range_suggestion}')" if self._range_suggestion else ""
+        ou.OMPL_ERROR(f"Invalid value '{text}' for parameter '{self._name}': {error}{accepted}")
 
     def getRangeSuggestion(self) -> str:  # noqa: N802
         """``"lo:step:hi"`` for numbers, a comma list for choices and booleans."""
@@ -299,8 +315,14 @@ def _parser(value_type: type, choices: tuple[str, ...] | None) -> Callable[[str]
 class ParamSet:
     """A planner's parameters, set and read as strings, as OMPL's ``ompl::base::ParamSet``.
 
-    ``ParamSet.of(settings)`` makes the set of a :class:`Settings` table; ``declareParam``
-    adds any other parameter from a setter and a getter, as in C++.
+    The C++ class's methods, with Python returning what C++ writes into its output
+    arguments: ``setParam``, ``setParams``, ``getParam(name)`` (the value; C++'s
+    ``getParam(name, value)``), ``getParams()`` (name -> value), ``getParamNames()``,
+    ``getParamValues()``, ``hasParam``, ``params[name]`` (the :class:`GenericParam`),
+    ``size()``, ``print``, ``declareParam``, ``add``, ``remove``, ``include``, ``clear``.
+    As in C++ (a ``std::map``), parameters are listed in the order of their names.
+
+    ``ParamSet.of(settings)`` makes the set of a :class:`Settings` table.
     """
 
     def __init__(self) -> None:
@@ -308,15 +330,18 @@ class ParamSet:
 
     @classmethod
     def of(cls, settings: Settings) -> ParamSet:
-        """The parameters of ``settings``' table, set through :meth:`Settings.set`."""
+        """The parameters of ``settings``' table, set through :meth:`Settings.update`."""
         params = cls()
         for row in settings.table():
-            params._params[row.name] = GenericParam(
-                row.name,
-                lambda value, name=row.name: settings.set(name, value),
-                lambda name=row.name: getattr(settings, name),
-                row.convert,
-                row.domain.range_suggestion(),
+            params.add(
+                GenericParam(
+                    row.name,
+                    partial(settings.set, row.name),
+                    partial(getattr, settings, row.name),
+                    row.convert,
+                    row.domain.range_suggestion(),
+                    settings,
+                )
             )
         return params
 
@@ -342,7 +367,23 @@ class ParamSet:
             range_suggestion = ",".join(choices)
         elif kind is bool and not range_suggestion:
             range_suggestion = "0,1"
-        self._params[name] = GenericParam(name, setter, getter, parse, range_suggestion)
+        self.add(GenericParam(name, setter, getter, parse, range_suggestion))
+
+    def add(self, param: GenericParam) -> None:
+        """Add ``param`` under its name (replacing a parameter of that name)."""
+        self._params[param.getName()] = param
+
+    def remove(self, name: str) -> None:
+        """Remove parameter ``name`` (nothing if there is none)."""
+        self._params.pop(name, None)
+
+    def include(self, other: ParamSet, prefix: str = "") -> None:
+        """Add ``other``'s parameters, named ``prefix.name`` when ``prefix`` is given (as C++)."""
+        for name, param in other._params.items():
+            self._params[f"{prefix}.{name}" if prefix else name] = param
+
+    def clear(self) -> None:
+        self._params.clear()
 
     def _unknown(self, name: str) -> str:
         return f"Unknown parameter '{name}'. Known parameters: {', '.join(sorted(self._params))}"
@@ -357,14 +398,40 @@ class ParamSet:
     def setParams(self, values: Mapping[str, Any], ignore_unknown: bool = False) -> bool:  # noqa: N802
         """Set several parameters; ``True`` only if all were set.
 
-        As in OMPL, each entry is tried on its own: a refused entry does not stop the
-        others. With ``ignore_unknown``, names this set does not have are skipped.
+        As in OMPL, an entry refused on its own (an unknown name, a value its parameter
+        does not accept) does not stop the others; with ``ignore_unknown``, names this set
+        does not have are skipped silently. Entries of one :class:`Settings` table are set
+        together, so the constraints between its parameters are checked on the resulting
+        combination: the order of ``values`` never matters.
         """
         all_set = True
+        tables: dict[int, tuple[Settings, dict[str, Any], list[GenericParam]]] = {}
         for name, value in values.items():
-            if ignore_unknown and name not in self._params:
+            if name not in self._params:
+                if not ignore_unknown:
+                    ou.OMPL_ERROR(self._unknown(name))
+                    all_set = False
                 continue
-            all_set = self.setParam(name, value) and all_set
+            param = self._params[name]
+            if param.settings is None:
+                all_set = param.setValue(value) and all_set
+                continue
+            try:
+                converted = param.parse(_format(value))
+            except ValueError as error:
+                param.refused(_format(value), error)
+                all_set = False
+                continue
+            _, table, members = tables.setdefault(id(param.settings), (param.settings, {}, []))
+            table[param.field] = converted
+            members.append(param)
+        for settings, table, members in tables.values():
+            try:
+                settings.update(table)
+            except ValueError as error:
+                names = ", ".join(param.getName() for param in members)
+                ou.OMPL_ERROR(f"Invalid combination of values for parameters {names}: {error}")
+                all_set = False
         return all_set
 
     def getParam(self, name: str) -> str:  # noqa: N802
@@ -372,15 +439,16 @@ class ParamSet:
         return self[name].getValue()
 
     def getParams(self) -> dict[str, str]:  # noqa: N802
-        """Every parameter's current value, as strings."""
-        return {name: param.getValue() for name, param in self._params.items()}
+        """Every parameter's current value, as strings, by name."""
+        return {name: self._params[name].getValue() for name in self.getParamNames()}
 
     def getParamNames(self) -> list[str]:  # noqa: N802
-        return list(self._params)
+        """The parameters' names, sorted (as C++'s ``std::map``)."""
+        return sorted(self._params)
 
     def getParamValues(self) -> list[str]:  # noqa: N802
         """The values, as strings, in the order of :meth:`getParamNames`."""
-        return [param.getValue() for param in self._params.values()]
+        return [self._params[name].getValue() for name in self.getParamNames()]
 
     def hasParam(self, name: str) -> bool:  # noqa: N802
         return name in self._params
@@ -405,7 +473,7 @@ class ParamSet:
         return name in self._params
 
     def __iter__(self) -> Iterator[str]:
-        return iter(self._params)
+        return iter(self.getParamNames())
 
     def __len__(self) -> int:
         return len(self._params)

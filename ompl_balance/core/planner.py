@@ -2,35 +2,42 @@
 
 :class:`TreePlanner` is an ``ob.Planner`` written in Python. A subclass declares its
 parameters (a :class:`~ompl_balance.core.params.Settings` dataclass, ``Settings``), its
-statistics record (``Stats``) and its search (:meth:`TreePlanner._plan`); the base does
-the rest the same way for all of them:
+statistics record (``Stats``), what it is (``SPECS``) and its search
+(:meth:`TreePlanner._plan`); the base does the rest the same way for all of them:
 
 * ``params()`` and the camelCase accessors, from the settings table;
-* ``setup()``: the counting checker (:func:`~ompl_balance.core.counting.ensure_counting`)
-  and the compiled tree scans for real-vector spaces, so that no ``solve()`` pays for them;
+* ``setup()``: the counting checker (:func:`~ompl_balance.core.counting.ensure_counting`);
+  nothing that takes time, since ``SimpleSetup.solve`` calls it inside the solve;
 * ``solve(ptc)``: the termination condition from what it was given (a condition, seconds
   or a callable), the seed of the solve (the ``seed`` parameter, or a draw from the planner's
   OMPL ``RNG``, which ``ompl.util.RNG.setSeed`` repeats), the work counted, and ``stats``;
-* the solution path added to the problem definition, and the trees as ``ob.PlannerData``;
+* the solution path added to the problem definition, and the planner's graph
+  (``getPlannerData(data)`` for Python callers, :meth:`TreePlanner.plannerData`);
+* ``getSpecs()``, ``printProperties()`` and ``printSettings()`` as OMPL's planners answer them;
 * progress properties (:meth:`TreePlanner.progressProperties`), readable while a solve runs.
+
+OMPL 2.0.1's bindings limit what C++ callers see of a Python planner: ``docs/drop-in.md``
+lists those limits and how the package works around them.
 """
 
 from __future__ import annotations
 
 import math
 import time
+import types
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeAlias
 
 import numpy as np
+import numpy.random  # imported now: numpy loads it lazily, and a solve must not pay for it
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
 from .counting import ensure_counting, read_work
 from .params import ParamSet, Settings, add_accessors
-from .spaces import Points, points_for, prepare
+from .spaces import Points, points_for
 from .trees import NO_PARENT, Tree
 
 #: OMPL's default range as a fraction of the space's maximum extent
@@ -42,27 +49,85 @@ START_TAG = 1
 GOAL_TAG = 2
 
 #: Anything ``solve`` takes: a condition (C++ callers), seconds, or a callable "stop now?".
-Limit = ob.PlannerTerminationCondition | float | Callable[[], bool]
+Limit: TypeAlias = "ob.PlannerTerminationCondition | float | Callable[[], bool]"
 
 
 def termination_condition(limit: Limit) -> ob.PlannerTerminationCondition:
     """A ``PlannerTerminationCondition`` from what ``solve`` was given.
 
     C++ callers (``SimpleSetup``, ``Benchmark``) pass a condition; Python callers may
-    pass a time limit in seconds (must be positive and finite) or a callable that
-    returns ``True`` when planning should stop.
+    pass a time limit in seconds or a callable that returns ``True`` when planning
+    should stop. As OMPL's ``Planner::solve(double)``, a limit of zero or less stops at
+    once; a limit that is not a finite number is refused.
     """
     if isinstance(limit, ob.PlannerTerminationCondition):
         return limit
     if isinstance(limit, (int, float)) and not isinstance(limit, bool):
-        if not math.isfinite(limit) or limit <= 0:
-            raise ValueError(f"solve() time limit must be a positive number of seconds, got {limit!r}")
-        return ob.timedPlannerTerminationCondition(float(limit))
+        if not math.isfinite(limit):
+            raise ValueError(f"solve() time limit must be a finite number of seconds, got {limit!r}")
+        return ob.timedPlannerTerminationCondition(max(float(limit), 0.0))
     if callable(limit):
         return ob.PlannerTerminationCondition(limit)
     raise TypeError(
         f"solve() takes a PlannerTerminationCondition, a time limit in seconds or a callable, got {type(limit).__name__}"
     )
+
+
+@dataclass(frozen=True)
+class PlannerSpecs:
+    """OMPL's ``ompl::base::PlannerSpecs``: what a planner is and does.
+
+    OMPL 2.0.1's ``Planner.getSpecs()`` cannot return the C++ record to Python, so the
+    package's planners answer ``getSpecs()`` with this one (same field names).
+    """
+
+    recognizedGoal: ob.GoalType = ob.GoalType.GOAL_ANY  # noqa: N815 (OMPL's names)
+    multithreaded: bool = False
+    approximateSolutions: bool = False  # noqa: N815
+    optimizingPaths: bool = False  # noqa: N815
+    directed: bool = False
+    provingSolutionNonExistence: bool = False  # noqa: N815
+    canReportIntermediateSolutions: bool = False  # noqa: N815
+
+
+class PlannerGraph(ob.PlannerData):
+    """An ``ob.PlannerData`` with the ``properties`` of C++'s ``PlannerData::properties``.
+
+    ``properties`` maps ``"name TYPE"`` to a value string (``"approx goal distance REAL"``),
+    as OMPL's planners fill it in ``getPlannerData``; OMPL 2.0.1's bindings do not expose
+    the C++ map, so the package's planners write this one.
+    """
+
+    def __init__(self, si: ob.SpaceInformation) -> None:
+        super().__init__(si)
+        self.properties: dict[str, str] = {}
+
+
+class _ForPythonCallers:
+    """A virtual method of ``ob.Planner`` that Python callers get from the package and C++
+    callers from OMPL.
+
+    OMPL 2.0.1's bindings dispatch ``getPlannerData``, ``printProperties`` and
+    ``printSettings`` called from C++ (``SimpleSetup``, ``ompl.tools.Benchmark``) to a Python
+    method of that name, and abort the process when they do (their arguments, a
+    ``PlannerData&`` or a ``std::ostream&``, cannot be handed to Python). nanobind looks a
+    Python override up once per planner object, at the first call from C++, and keeps the
+    answer. :class:`TreePlanner`'s constructor makes those first calls while this descriptor
+    still answers with OMPL's own method, so C++ callers keep OMPL's; from then on, Python
+    callers get the package's method.
+    """
+
+    def __init__(self, method: Callable[..., Any]) -> None:
+        self.method = method
+        self.name = method.__name__
+        self.__doc__ = method.__doc__
+
+    def __get__(self, planner: Any, owner: type | None = None) -> Any:
+        if planner is None:
+            return self.method
+        if planner.__dict__.get("_cpp_overrides_resolved", False):
+            return types.MethodType(self.method, planner)
+        return getattr(ob.Planner, self.name).__get__(planner, owner)
 
 
 @dataclass
@@ -76,14 +141,18 @@ class Progress:
 class TreePlanner(ob.Planner):
     """Base of the package's planners (see the module docstring).
 
-    Subclasses set ``Settings`` (their parameter table, which must have ``seed``) and
+    Subclasses set ``Settings`` (their parameter table, which must have ``seed``),
     ``Stats`` (a dataclass with ``status``, ``states_checked``, ``motions_checked``,
-    ``distance_queries`` and ``time`` fields besides those :meth:`_plan` returns), implement
-    :meth:`_plan` (keeping :attr:`progress` current) and :meth:`_fill_planner_data`.
+    ``distance_queries`` and ``time`` fields besides those :meth:`_plan` returns) and
+    ``SPECS``, implement :meth:`_plan` (keeping :attr:`progress` current) and
+    :meth:`_fill_planner_data`.
     """
 
     Settings: ClassVar[type[Settings]]
     Stats: ClassVar[type]
+    SPECS: ClassVar[PlannerSpecs] = PlannerSpecs()
+    #: The constructor's signature, for the message refusing other arguments.
+    SIGNATURE: ClassVar[str] = "(si, name=None)"
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -91,7 +160,14 @@ class TreePlanner(ob.Planner):
             add_accessors(cls, cls.Settings)
 
     def __init__(self, si: ob.SpaceInformation, name: str | None = None) -> None:
+        if name is not None and not isinstance(name, str):
+            self._refuse_argument("name must be a str", name)
         super().__init__(si, name or type(self).__name__)
+        # nanobind resolves the C++ side of the Python-only methods now (see _ForPythonCallers).
+        ob.Planner.getPlannerData(self, ob.PlannerData(si))
+        ob.Planner.printProperties(self)
+        ob.Planner.printSettings(self)
+        self._cpp_overrides_resolved = True
         self.settings: Any = type(self).Settings()
         self._params = ParamSet.of(self.settings)
         self._rng = ou.RNG()  # per-planner stream, seeded from OMPL's global seed
@@ -99,15 +175,43 @@ class TreePlanner(ob.Planner):
         self.progress = Progress()
         self.stats: Any = None
 
+    @classmethod
+    def _refuse_argument(cls, problem: str, value: Any) -> None:
+        raise TypeError(f"{cls.__name__}{cls.SIGNATURE}: {problem}, got {value!r}")
+
     def params(self) -> ParamSet:
         """This planner's parameters (OMPL's ``ParamSet`` semantics)."""
         return self._params
 
+    def getSpecs(self) -> PlannerSpecs:  # noqa: N802 (OMPL's names)
+        """What the planner is and does, as OMPL's ``PlannerSpecs``."""
+        return self.SPECS
+
+    @_ForPythonCallers
+    def printProperties(self) -> str:  # noqa: N802
+        """The planner's specs and parameter names, in the words of OMPL's ``Planner::printProperties``."""
+        specs = self.SPECS
+
+        def yes(flag: bool) -> str:
+            return "Yes" if flag else "No"
+
+        return (
+            f"Planner {self.getName()} specs:\n"
+            f"Multithreaded:                 {yes(specs.multithreaded)}\n"
+            f"Reports approximate solutions: {yes(specs.approximateSolutions)}\n"
+            f"Can optimize solutions:        {yes(specs.optimizingPaths)}\n"
+            f"Aware of the following parameters: {' '.join(self._params.getParamNames())}\n"
+        )
+
+    @_ForPythonCallers
+    def printSettings(self) -> str:  # noqa: N802
+        """The parameters and their values, as OMPL's ``Planner::printSettings``."""
+        values = "".join(f"{name} = {value}\n" for name, value in self._params.getParams().items())
+        return f"Declared parameters for planner {self.getName()}:\n{values}"
+
     def setup(self) -> None:
         super().setup()
-        si = self.getSpaceInformation()
-        ensure_counting(si)
-        prepare(si)
+        ensure_counting(self.getSpaceInformation())
 
     def clear(self) -> None:
         super().clear()
@@ -117,7 +221,7 @@ class TreePlanner(ob.Planner):
         """Plan until the search ends or ``ptc`` says stop (a condition, seconds or a callable)."""
         ptc = termination_condition(ptc)
         self.checkValidity()
-        self._before_solve()
+        self._before_solve(ptc)
         si = self.getSpaceInformation()
         began = time.perf_counter()
         work_before = read_work(si)
@@ -159,8 +263,8 @@ class TreePlanner(ob.Planner):
         """A seed from the planner's OMPL ``RNG`` (repeated by ``ompl.util.RNG.setSeed``)."""
         return self._rng.uniformInt(1, 2**31 - 2)
 
-    def _before_solve(self) -> None:
-        """Checks and one-time work before a solve is timed (override)."""
+    def _before_solve(self, ptc: ob.PlannerTerminationCondition) -> None:
+        """Checks and one-time work before a solve's statistics start (override); within ``ptc``."""
 
     def _plan(
         self, ptc: ob.PlannerTerminationCondition, points: Points, rng: np.random.Generator
@@ -177,20 +281,34 @@ class TreePlanner(ob.Planner):
             path.append(points.ompl_state(point))
         self.getProblemDefinition().addSolutionPath(path, False, 0.0, self.getName())
 
-    def plannerData(self) -> ob.PlannerData:  # noqa: N802 (OMPL's style; see the note below)
-        """The planner's graph as an ``ob.PlannerData`` that owns copies of its states.
+    @_ForPythonCallers
+    def getPlannerData(self, data: ob.PlannerData) -> None:  # noqa: N802 (OMPL's name)
+        """Add the planner's graph to ``data``, as the stock planner's ``getPlannerData``.
 
-        A Python planner must not define ``getPlannerData``: C++ callers
-        (``SimpleSetup.getPlannerData``, ``ompl.tools.Benchmark``) would dispatch to it and
-        OMPL 2.0's bindings abort the process, so ``ss.getPlannerData`` returns an empty
-        graph for the package's planners and this method gives the graph instead.
+        ``data`` owns copies of the states afterwards (``decoupleFromPlanner``). When ``data``
+        has ``properties`` (a :class:`PlannerGraph`), they are filled as OMPL fills
+        ``PlannerData::properties``: the progress properties' values, and what the planner
+        adds (:meth:`_graph_properties`). Called from C++ (``SimpleSetup.getPlannerData``,
+        ``ompl.tools.Benchmark``) this is OMPL's ``Planner::getPlannerData``, which adds nothing.
         """
-        data = ob.PlannerData(self.getSpaceInformation())
+        properties = getattr(data, "properties", None)
+        if isinstance(properties, dict):
+            properties.update({name: value() for name, value in self.progressProperties().items()})
+            properties.update(self._graph_properties())
         if self._points is not None:
             keep_alive: list[ob.State] = []  # the graph points into these until it is decoupled
             self._fill_planner_data(data, self._points, keep_alive)
             data.decoupleFromPlanner()
+
+    def plannerData(self) -> PlannerGraph:  # noqa: N802 (OMPL's style)
+        """The planner's graph as a new :class:`PlannerGraph` (see :meth:`getPlannerData`)."""
+        data = PlannerGraph(self.getSpaceInformation())
+        self.getPlannerData(data)
         return data
+
+    def _graph_properties(self) -> dict[str, str]:
+        """``PlannerData`` properties the planner sets in ``getPlannerData`` (override)."""
+        return {}
 
     def _fill_planner_data(self, data: ob.PlannerData, points: Points, keep_alive: list[ob.State]) -> None:
         """Add the planner's vertices and edges to ``data`` (override)."""
@@ -205,10 +323,14 @@ class TreePlanner(ob.Planner):
         keep_alive: list[ob.State],
         roots_are_starts: bool = True,
         goal_nodes: Sequence[int] = (),
+        towards_root: bool = False,
     ) -> list[int]:
-        """Add ``tree``'s nodes (tagged ``tag``) and its edges parent -> child; returns the vertex
-        index of each node. Roots are start vertices (goal vertices unless ``roots_are_starts``);
-        ``goal_nodes`` are marked as goal vertices."""
+        """Add ``tree``'s nodes (tagged ``tag``) and its edges; returns the vertex index of each node.
+
+        Edges run parent -> child, or child -> parent with ``towards_root`` (OMPL's goal
+        trees). Roots are start vertices (goal vertices unless ``roots_are_starts``);
+        ``goal_nodes`` are marked as goal vertices.
+        """
         goals = set(goal_nodes)
         indices = []
         for node in range(len(tree)):
@@ -222,6 +344,10 @@ class TreePlanner(ob.Planner):
             else:
                 indices.append(data.addVertex(vertex))
         for node in range(len(tree)):
-            if tree.parent(node) != NO_PARENT:
-                data.addEdge(indices[tree.parent(node)], indices[node])
+            parent = tree.parent(node)
+            if parent != NO_PARENT:
+                if towards_root:
+                    data.addEdge(indices[node], indices[parent])
+                else:
+                    data.addEdge(indices[parent], indices[node])
         return indices

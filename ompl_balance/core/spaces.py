@@ -26,7 +26,7 @@ from typing import Any, Protocol
 import numpy as np
 from ompl import base as ob
 
-from .trees import ArrayTree, StateTree, Tree, load_scans
+from .trees import ArrayTree, StateTree, Tree
 
 _SAMPLE_BLOCK = 256  # uniform samples drawn from numpy at a time
 _EQUAL_TOLERANCE = 2.0 * float(np.finfo(float).eps)
@@ -194,10 +194,3 @@ def _is_real_vector(si: ob.SpaceInformation) -> bool:
 def points_for(si: ob.SpaceInformation, rng: np.random.Generator) -> Points:
     """The fast array view for plain real-vector spaces, OMPL states otherwise."""
     return RealVectorPoints(si, rng) if _is_real_vector(si) else StatePoints(si)
-
-
-def prepare(si: ob.SpaceInformation) -> None:
-    """One-time work a planner's ``setup()`` does so that ``solve()`` does not: for
-    real-vector spaces, load the compiled tree scans (:func:`~ompl_balance.core.trees.load_scans`)."""
-    if _is_real_vector(si):
-        load_scans()

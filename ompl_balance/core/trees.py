@@ -4,18 +4,25 @@ Two stores with one interface (:class:`Tree`), chosen by :mod:`ompl_balance.core
 
 :class:`ArrayTree`
     real-vector states in one contiguous ``(capacity, dim)`` float64 array grown by
-    doubling; nearest and near neighbours by one compiled scan of all nodes (exact).
+    doubling; nearest and near neighbours by a scan of all nodes (exact): numpy while
+    the process's trees are small, the compiled kernels of :mod:`ompl_balance.core.scans`
+    once a tree has reached :data:`COMPILED_SCANS_FROM` nodes and they have loaded in a
+    background thread (so that no solve waits for numba), the same answers either way.
 :class:`StateTree`
     OMPL states of any space in a list; nearest neighbour by ``si.distance`` over all
     nodes (exact, slower: one call into OMPL per node).
 
 Both keep, per node, the index of its parent (``-1`` for a root) and of its root, so
-a path is read off by following parents. Node ``i`` is the ``i``-th state added.
+a path is read off by following parents. Node ``i`` is the ``i``-th state added (until
+:meth:`Tree.compact` removes nodes and renumbers the rest in order).
 """
 
 from __future__ import annotations
 
 import math
+import os
+import sys
+import threading
 from types import ModuleType
 from typing import Any, Protocol
 
@@ -40,6 +47,7 @@ class Tree(Protocol):
     def root(self, index: int) -> int: ...
     def branch(self, index: int) -> list[int]: ...
     def reparent(self, subtree: np.ndarray, parent: int) -> None: ...
+    def compact(self, keep: np.ndarray) -> np.ndarray: ...
     def nearest(self, state: Any) -> tuple[int, float]: ...
     def near(self, state: Any, radius: float) -> tuple[np.ndarray, np.ndarray]: ...
     def distances(self, state: Any) -> np.ndarray: ...
@@ -89,34 +97,108 @@ class _Links:
         self.parents[subtree[0]] = parent
         self.roots[subtree] = self.roots[parent]
 
+    def compact(self, keep: np.ndarray) -> np.ndarray:
+        """Keep only the nodes where ``keep`` (``(len(tree),)`` bool) is true, renumbered in
+        order; every kept node's parent must be kept. Returns each old node's new index
+        (``NO_PARENT`` for a removed node)."""
+        kept = np.flatnonzero(keep[: self.size])
+        new_index = np.full(self.size, NO_PARENT, dtype=np.int64)
+        new_index[kept] = np.arange(len(kept))
+        parents = self.parents[kept]
+        if np.any((parents != NO_PARENT) & (new_index[np.maximum(parents, 0)] == NO_PARENT)):
+            raise ValueError("compact() would keep a node whose parent it removes")
+        self.parents[: len(kept)] = np.where(parents == NO_PARENT, NO_PARENT, new_index[np.maximum(parents, 0)])
+        self.roots[: len(kept)] = new_index[self.roots[kept]]
+        self._keep_states(kept)
+        self.size = len(kept)
+        return new_index
+
+    def _keep_states(self, kept: np.ndarray) -> None:
+        """Keep the states of nodes ``kept`` (ascending), as nodes ``0 .. len(kept) - 1``."""
+        raise NotImplementedError
+
     def clear(self) -> None:
         self.size = 0
 
 
+#: Tree size at which an :class:`ArrayTree` starts loading the compiled kernels in the
+#: background; until they are loaded, every tree scans with numpy, afterwards every tree
+#: with the kernels (``benchmarks/bench_rrtc.py --scans`` measures the trade-off).
+COMPILED_SCANS_FROM = 1024
+
+
+class _ScanLoader:
+    """Loads the compiled scans once per process: now (:meth:`load`) or in the background
+    (:meth:`loaded`)."""
+
+    def __init__(self) -> None:
+        self.scans: ModuleType | None = None
+        self.thread: threading.Thread | None = None
+
+    def load(self) -> ModuleType:
+        from . import scans
+
+        self.scans = scans
+        return scans
+
+    def loaded(self) -> ModuleType | None:
+        if self.scans is None and self.thread is None:
+            if "ompl_balance.core.scans" in sys.modules:  # imported by someone else, e.g. a forkserver's preload
+                return self.load()
+            self.thread = threading.Thread(target=self.load, name="ompl_balance-load-scans")
+            self.thread.start()
+        return self.scans
+
+    def finish(self) -> None:
+        """Wait for a background load (a process must not fork in the middle of an import)."""
+        if self.thread is not None:
+            self.thread.join()
+
+
+_LOADER = _ScanLoader()
+os.register_at_fork(before=_LOADER.finish)
+
+
 def load_scans() -> ModuleType:
-    """The compiled nearest/near scans (:mod:`ompl_balance.core.scans`).
+    """The compiled nearest/near scans (:mod:`ompl_balance.core.scans`), loaded now.
 
-    The first call imports numba and loads the kernels (about half a second, once per
-    process); planners call it from ``setup()`` so that no solve pays it.
+    The first call in a process imports numba and loads the kernels (about half a second).
     """
-    from . import scans
+    return _LOADER.load()
 
-    return scans
+
+def compiled_scans() -> ModuleType | None:
+    """The compiled scans if they are loaded, else ``None`` (and their loading started in a
+    background thread, so that no solve waits for it)."""
+    return _LOADER.loaded()
+
+
+def _squared_distances(states: np.ndarray, query: np.ndarray) -> np.ndarray:
+    """Squared Euclidean distance of each row of ``states`` to ``query``, ``(len(states),)``.
+
+    Summed over the coordinates in order, exactly as the compiled kernels do, so both
+    scans give the same numbers to the last bit.
+    """
+    offsets = states - query
+    squared = offsets[:, 0] * offsets[:, 0]
+    for k in range(1, offsets.shape[1]):
+        squared += offsets[:, k] * offsets[:, k]
+    return squared
 
 
 class ArrayTree(_Links):
     """Real-vector states of one tree, shape ``(len(tree), dim)``.
 
-    Nearest and near queries scan all nodes in one compiled loop (exact, and for the
-    tree sizes sampling planners reach, faster than any index would be from Python).
+    Nearest and near queries scan all nodes (exact): with numpy until the compiled kernels
+    are loaded (a tree of :data:`COMPILED_SCANS_FROM` nodes starts their loading), then in
+    one compiled loop (for the tree sizes sampling planners reach, faster than any index
+    would be from Python). Both scans return the same answers.
     """
 
     def __init__(self, dim: int, capacity: int = 1024) -> None:
         super().__init__(capacity)
-        scans = load_scans()
-        self._nearest, self._within = scans.nearest, scans.within
         self._states = np.empty((capacity, dim))
-        # scratch output of near(), one slot per node
+        # scratch output of the compiled near(), one slot per node
         self._near_indices = np.empty(capacity, dtype=np.int64)
         self._near_distances = np.empty(capacity)
 
@@ -138,22 +220,42 @@ class ArrayTree(_Links):
         self._states[index] = state
         return index
 
+    def _compiled(self) -> ModuleType | None:
+        """The compiled scans once loaded (whatever the size); their loading starts when a
+        tree first reaches :data:`COMPILED_SCANS_FROM` nodes."""
+        scans = _LOADER.scans
+        if scans is None and self.size >= COMPILED_SCANS_FROM:
+            scans = compiled_scans()
+        return scans
+
     def nearest(self, state: np.ndarray) -> tuple[int, float]:
         """Index of the node closest to ``state`` (Euclidean; the first on ties) and its distance."""
         if self.size == 0:
             raise ValueError("nearest() of an empty tree: add a root first")
-        index, squared = self._nearest(self._states, self.size, state)
-        return index, math.sqrt(squared)
+        scans = self._compiled()
+        if scans is None:
+            squared = _squared_distances(self._states[: self.size], state)
+            index = int(squared.argmin())
+            return index, math.sqrt(squared[index])
+        index, nearest_squared = scans.nearest(self._states, self.size, state)
+        return index, math.sqrt(nearest_squared)
 
     def near(self, state: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the nodes within ``radius`` of ``state`` (exact, ascending) and their distances."""
-        count = self._within(self._states, self.size, state, radius, self._near_indices, self._near_distances)
+        scans = self._compiled()
+        if scans is None:
+            squared = _squared_distances(self._states[: self.size], state)
+            indices = np.flatnonzero(squared <= radius * radius)
+            return indices, np.sqrt(squared[indices])
+        count = scans.within(self._states, self.size, state, radius, self._near_indices, self._near_distances)
         return self._near_indices[:count].copy(), self._near_distances[:count].copy()
 
     def distances(self, state: np.ndarray) -> np.ndarray:
         """Euclidean distance from every node to ``state``, ``(len(tree),)``."""
-        offsets = self._states[: self.size] - state
-        return np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
+        return np.sqrt(_squared_distances(self._states[: self.size], state))
+
+    def _keep_states(self, kept: np.ndarray) -> None:
+        self._states[: len(kept)] = self._states[kept]
 
 
 class StateTree(_Links):
@@ -196,6 +298,9 @@ class StateTree(_Links):
         distances = self.distances(state)
         within = np.flatnonzero(distances <= radius)
         return within, distances[within]
+
+    def _keep_states(self, kept: np.ndarray) -> None:
+        self._states = [self._states[index] for index in kept.tolist()]
 
     def clear(self) -> None:
         super().clear()
