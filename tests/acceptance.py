@@ -245,15 +245,17 @@ def _solve_timed(planner: ob.Planner, si: ob.SpaceInformation, is_valid, outcome
     return solved
 
 
-def _simplify_timed(simplify: Callable[[], object], si: ob.SpaceInformation, is_valid, outcome: Outcome) -> None:
+def _simplify_timed(simplify: Callable[[], object], si: ob.SpaceInformation, is_valid, outcome: Outcome) -> object:
+    """Run ``simplify``, adding its time and work to ``outcome``; returns what it returned."""
     checks, checker_seconds = _work(si, is_valid)
     began, cpu_began = time.perf_counter(), time.process_time()
-    simplify()
+    result = simplify()
     outcome.simplify_time += time.perf_counter() - began
     outcome.cpu_time += time.process_time() - cpu_began
     checks_after, checker_seconds_after = _work(si, is_valid)
     outcome.simplify_checks += checks_after - checks
     outcome.simplify_checker_time += checker_seconds_after - checker_seconds
+    return result
 
 
 def _map_run(entry: PlannerEntry, env: Environment2D, run: int, outcome: Outcome) -> None:
@@ -315,9 +317,16 @@ class _CirclesRun:
         if not _solve_timed(self.planner, si, self.circles, outcome):
             return
         path = pdef.getSolutionPath()
-        _simplify_timed(lambda: og.PathSimplifier(si).simplify(path, SOLUTION_TIME), si, self.circles, outcome)
-        outcome.length += path.length()
+        # The planner's own path is re-checked as it returned it; the simplified one when OMPL's
+        # simplifier reports it valid (``simplify`` returns false when its B-spline smoothing
+        # left the path "slightly touching on an invalid region" and its repair failed).
         faults = _path_faults(si, path, query.start, self.circles)
+        simplified = _simplify_timed(
+            lambda: og.PathSimplifier(si).simplify(path, SOLUTION_TIME), si, self.circles, outcome
+        )
+        if simplified:
+            faults += [f"after simplification: {fault}" for fault in _path_faults(si, path, query.start, self.circles)]
+        outcome.length += path.length()
         outcome.faulty_paths.extend(f"query {index}: {fault}" for fault in faults)
 
 

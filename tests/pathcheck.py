@@ -24,7 +24,7 @@ def invalid_points(
     bad = []
     states = [path.getState(i) for i in range(path.getStateCount())]
     for segment, (a, b) in enumerate(itertools.pairwise(states)):
-        steps = space.validSegmentCount(a, b)
+        steps = max(1, space.validSegmentCount(a, b))  # a segment of length 0 counts 0 segments
         for step in range(steps + 1):
             space.interpolate(a, b, step / steps, scratch)
             if not (si.satisfiesBounds(scratch) and is_valid(scratch)):
