@@ -87,18 +87,29 @@ class Environment:
 
 
 class WorkCounter:
-    """States and motions checked; one instance is shared by a checker and its motion validator."""
+    """Work done for a planner; one instance is shared by a checker and its motion validator.
 
-    def __init__(self):
+    ``states_checked``: configurations evaluated (a state check, a state of a discrete
+    edge, a configuration a certified edge was bounded at); ``motions_checked``: edges;
+    ``distance_queries``: FCL exact distance queries (certified motions only).
+    """
+
+    def __init__(self) -> None:
         self.states_checked = 0
         self.motions_checked = 0
+        self.distance_queries = 0
 
     def counters(self) -> dict[str, int]:
-        return {"states_checked": self.states_checked, "motions_checked": self.motions_checked}
+        return {
+            "states_checked": self.states_checked,
+            "motions_checked": self.motions_checked,
+            "distance_queries": self.distance_queries,
+        }
 
     def reset(self) -> None:
         self.states_checked = 0
         self.motions_checked = 0
+        self.distance_queries = 0
 
 
 class CollisionChecker:

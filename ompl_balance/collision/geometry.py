@@ -98,6 +98,31 @@ class Shape:
             return trimesh.creation.cylinder(radius=self.dims[0], height=self.dims[1], sections=64)
         return self.mesh
 
+    def hull_vertices(self) -> np.ndarray | None:
+        """Vertices (m, 3) of a mesh's convex hull (``None`` for primitives); computed once."""
+        if self.mesh is None:
+            return None
+        known = _HULL_OF.get(self)
+        if known is None:
+            hull = self.mesh.convex_hull
+            known = (np.array(hull.vertices, dtype=float), _solid_mesh(self.mesh, hull))
+            known[0].setflags(write=False)
+            _HULL_OF[self] = known
+        return known[0]
+
+    @property
+    def convex(self) -> bool:
+        """Whether the shape is (nearly) its convex hull, so that FCL's distance to it is the hull's.
+
+        Primitives are convex; a mesh counts as convex when it is closed and its volume is
+        within 0.1 % of its hull's (its triangles are then the hull's surface but for small
+        dents: the hull is what is treated as in contact).
+        """
+        if self.mesh is None:
+            return True
+        self.hull_vertices()
+        return _HULL_OF[self][1]
+
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         """An oriented box containing the shape: ``(pose (4, 4) in the shape frame, half extents (3,))``."""
         if self.kind == "box":
@@ -158,6 +183,18 @@ class Shape:
                 break
             pieces[widest : widest + 1] = halves
         return np.array([p.centre for p in pieces]), np.array([p.radius for p in pieces])
+
+
+_HULL_OF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # Shape -> (hull vertices, convex)
+
+
+def _solid_mesh(mesh: trimesh.Trimesh, hull: trimesh.Trimesh) -> bool:
+    """Whether ``mesh`` (vertices merged) is closed and fills its convex ``hull`` to 0.1 % of its volume."""
+    merged = mesh.copy()
+    merged.merge_vertices()
+    if not merged.is_watertight:
+        return False
+    return bool(abs(abs(merged.volume) - hull.volume) <= 1e-3 * hull.volume)
 
 
 class _BoxPiece:
