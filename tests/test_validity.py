@@ -159,7 +159,7 @@ def check_motion_validator(robot, environment, edges_count, seed):
     rng = np.random.default_rng(seed)
     checker = CollisionChecker(robot, environment)
     space, si = make_si(robot, checker)
-    _validity, motion = setup_robot(si, checker)
+    _validity, motion = setup_robot(si, checker, motion="discrete")
     si.setup()
     _discrete_space, discrete_si = make_si(robot, checker)
     discrete_si.setStateValidityChecker(StateValidityChecker(discrete_si, CollisionChecker(robot, environment)))

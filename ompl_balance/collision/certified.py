@@ -165,7 +165,11 @@ class MotionCertifier:
             around.append((obstacle.pose[:3, :3] @ centre[0] + obstacle.pose[:3, 3], radius[0]))
         convex = [s.convex for s, _ in shapes]
         solid = np.array(
-            [convex[g] and convex[self._geometries + o] for o in range(self._obstacles) for g in range(self._geometries)]
+            [
+                convex[g] and convex[self._geometries + o]
+                for o in range(self._obstacles)
+                for g in range(self._geometries)
+            ]
             + [convex[a] and convex[b] for a, b in robot.self_collision_pairs],
             dtype=bool,
         )

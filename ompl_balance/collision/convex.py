@@ -203,7 +203,9 @@ def _closest_on_simplex(simplex: np.ndarray, n: int) -> tuple[Vector, int]:  # p
     best_rows, best_count = (0, 0, 0), 0
     inside = True
     for opposite in range(4):
-        f0, f1, f2 = (1, 2, 3) if opposite == 0 else (0, 2, 3) if opposite == 1 else (0, 1, 3) if opposite == 2 else (0, 1, 2)
+        f0, f1, f2 = (
+            (1, 2, 3) if opposite == 0 else (0, 2, 3) if opposite == 1 else (0, 1, 3) if opposite == 2 else (0, 1, 2)
+        )
         a, b, c, d = _row(simplex, f0), _row(simplex, f1), _row(simplex, f2), _row(simplex, opposite)
         normal = _cross(_sub(b, a), _sub(c, a))
         side_origin, side_other = -_dot(a, normal), _dot(_sub(d, a), normal)

@@ -29,6 +29,7 @@ import yourdfpy
 from numba import njit
 
 from .geometry import Shape
+from .urdf import check_urdf
 
 MOVING_JOINTS = ("revolute", "continuous", "prismatic")
 
@@ -248,8 +249,7 @@ class RobotModel:
         package. Only ``<collision>`` elements are read; ``<visual>`` is ignored.
         """
         urdf_path = Path(urdf_path)
-        if not urdf_path.is_file():
-            raise FileNotFoundError(f"URDF file not found: {urdf_path}")
+        check_urdf(urdf_path)  # what and where, before yourdfpy's terser messages
         try:
             urdf = yourdfpy.URDF.load(
                 str(urdf_path),
