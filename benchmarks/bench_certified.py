@@ -83,7 +83,9 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=3, help="runs per problem, planner and validator (default 3)")
     parser.add_argument("--time-limit", type=float, default=10.0, help="seconds per run (default 10)")
     parser.add_argument("--step", type=float, default=0.005, help="re-check resolution, rad per joint (default 0.005)")
-    parser.add_argument("--scenarios", default=",".join(SCENARIOS), help="comma-separated subset of " + ", ".join(SCENARIOS))
+    parser.add_argument(
+        "--scenarios", default=",".join(SCENARIOS), help="comma-separated subset of " + ", ".join(SCENARIOS)
+    )
     args = parser.parse_args()
     ou.RNG.setSeed(1)
     ou.setLogLevel(ou.LOG_ERROR)

@@ -240,6 +240,7 @@ def advance(
     clearance: float,
     handover: float,
     floor: float,
+    settle: float,
     stop: bool,
     start: Ends,
     end: Ends,
@@ -247,11 +248,13 @@ def advance(
     speed: np.ndarray,
     hard_pair: np.ndarray,
     hard_span: np.ndarray,
-) -> tuple[bool, float, int, int, np.ndarray, np.ndarray]:  # pragma: no cover (compiled)
+) -> tuple[bool, float, int, int, int, np.ndarray, np.ndarray]:  # pragma: no cover (compiled)
     """Certify the edge ``a -> b`` (dof,) for every pair but the hard segments.
 
     ``clearance`` (m): pairs must stay farther apart. A segment failing with a travel
-    bound below ``floor`` (m) fails the edge; ``stop``: return at the first failure.
+    bound below ``floor`` (m) fails the edge; ``stop``: return at the first failure;
+    otherwise a segment reaching a failure found earlier is refined to ``settle`` (m) of
+    travel only (where the last certified fraction is wanted, not a certificate).
     ``start`` and ``end`` are the bounds known at ``a`` and ``b`` and receive what is
     computed there. ``warm`` (pairs, 3): each pair's last GJK direction. Writes each pair's
     travel bound per unit ``t`` into ``speed``. Hard segments: pair ``hard_pair[i]``,
@@ -259,14 +262,15 @@ def advance(
 
     Returns ``failed`` (an end outside the joint bounds or not finite, a contact, or a
     segment that cannot be certified), ``bad`` (the edge is certified for all pairs on
-    ``[0, bad]``, hard segments aside), the number of hard segments, the number of
-    configurations evaluated, and the (possibly grown) hard arrays.
+    ``[0, bad]``, hard segments aside), the number of hard segments, the numbers of
+    configurations evaluated and of GJK distance bounds computed, and the (possibly grown)
+    hard arrays.
     """
     dof = len(a)
     for j in range(dof):
         for value in (a[j], b[j]):  # (NaN fails both comparisons)
             if not (model.joint_lower[j] <= value <= model.joint_upper[j]):
-                return True, 0.0, 0, 0, hard_pair, hard_span
+                return True, 0.0, 0, 0, 0, hard_pair, hard_span
     geometries, obstacles = len(volumes.outer_radius), len(volumes.box_half)
     pairs = obstacles * geometries + len(volumes.pairs)
     delta = b - a
@@ -313,9 +317,9 @@ def advance(
                     failed = True
                     bad = min(bad, float(side))
     if failed and stop:
-        return failed, 0.0, hard, 2, hard_pair, hard_span
+        return failed, 0.0, hard, 2, 0, hard_pair, hard_span
     count, level = pairs, 0
-    evaluated = 2
+    evaluated, bounded = 2, 0
     while count > 0:
         width = 0.5**level
         split = np.empty(count, dtype=np.int64)
@@ -343,6 +347,7 @@ def advance(
                 point = seg_point[e, side]
                 target = need - seg_lower[e, 1 - side]
                 lower, upper = hull_bounds(pair, point_poses[point], volumes, model, warm, identity, target)
+                bounded += 1
                 seg_lower[e, side] = max(seg_lower[e, side], lower)
                 seg_final[e, side] = lower < target
                 if point < 2:
@@ -352,7 +357,7 @@ def advance(
                 if model.solid[pair] and upper <= contact:
                     failed = True
                     if stop:
-                        return failed, 0.0, hard, evaluated, hard_pair, hard_span
+                        return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span
                     bad = min(bad, point_t[point])
                 if seg_lower[e, 0] + seg_lower[e, 1] > need:
                     break
@@ -366,10 +371,10 @@ def advance(
                 hard_span[hard, 2], hard_span[hard, 3] = seg_lower[e, 0], seg_lower[e, 1]
                 hard += 1
                 continue
-            if travel < floor or level >= MAX_LEVEL:
+            if travel < floor or level >= MAX_LEVEL or (failed and t0 + width >= bad and travel < settle):
                 failed = True
                 if stop:
-                    return failed, 0.0, hard, evaluated, hard_pair, hard_span
+                    return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span
                 bad = min(bad, t0)
                 continue
             split[splits] = e
@@ -406,11 +411,12 @@ def advance(
                 spare = spheres[i] + min(seg_lower[e, 0], seg_lower[e, 1]) - 2.0 * clearance
                 if lower < target and not (spare > 0.0 and 0.5 * speed[pair] * width <= SPHERE_REACH * spare):
                     lower, upper = hull_bounds(pair, point_poses[middle], volumes, model, warm, identity, target)
+                    bounded += 1
                     lower, final = max(lower, spheres[i]), lower < target
                     if model.solid[pair] and upper <= contact:
                         failed = True
                         if stop:
-                            return failed, 0.0, hard, evaluated, hard_pair, hard_span
+                            return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span
                         bad = min(bad, point_t[middle])
                 for side in range(2):
                     child = following + side
@@ -424,4 +430,4 @@ def advance(
         seg_pair, seg_k, seg_point, seg_lower, seg_final = next_pair, next_k, next_point, next_lower, next_final
         count = following
         level += 1
-    return failed, bad, hard, evaluated, hard_pair, hard_span
+    return failed, bad, hard, evaluated, bounded, hard_pair, hard_span

@@ -59,6 +59,7 @@ import numpy as np
 from .advancement import DISTANCE_TOLERANCE, Ends, Model, advance, hull_bounds, sphere_bounds
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
+from .screening import stand_ins
 from .travel import travel_weights
 
 #: A segment whose travel bound is below this (m) and is still not certified is not cut
@@ -150,7 +151,8 @@ class MotionCertifier:
         self._memory = _EndMemory(max(2, remembered), self.pair_count)
         # the compiled phase is called without numba's type dispatch (several microseconds
         # of an edge's few tens): the argument types are fixed here
-        arguments = self._arguments(robot.lower, robot.lower, 0, 0, MIN_TRAVEL, stop=True)
+        lower = np.ascontiguousarray(robot.lower, dtype=float)
+        arguments = self._arguments(lower, lower, 0, 0, MIN_TRAVEL, stop=True)
         advance(*arguments)
         self._advance = advance.overloads[tuple(numba.typeof(x) for x in arguments)].entry_point
 
@@ -188,8 +190,8 @@ class MotionCertifier:
             self_weight=self_weight.reshape(-1, robot.dof),
             fixed=fixed,
             solid=solid,
-            joint_lower=np.asarray(robot.lower, dtype=float),
-            joint_upper=np.asarray(robot.upper, dtype=float),
+            joint_lower=np.ascontiguousarray(robot.lower, dtype=float),
+            joint_upper=np.ascontiguousarray(robot.upper, dtype=float),
         )
 
     # ------------------------------------------------------------------ public API
@@ -211,12 +213,13 @@ class MotionCertifier:
         if a.shape != (self._robot.dof,) or b.shape != a.shape:
             return False, 0.0
         start, end = self._memory.row(a), self._memory.row(b)
-        floor = max(MIN_TRAVEL, LAST_VALID_TRAVEL) if last_valid else MIN_TRAVEL
+        settle = max(MIN_TRAVEL, LAST_VALID_TRAVEL) if last_valid else MIN_TRAVEL
         if self.checker.prefilter:
-            failed, bad, hard, evaluated, self._hard_pair, self._hard_span = self._advance(
-                *self._arguments(a, b, start, end, floor, stop=not last_valid)
+            failed, bad, hard, evaluated, bounded, self._hard_pair, self._hard_span = self._advance(
+                *self._arguments(a, b, start, end, settle, stop=not last_valid)
             )
             counter.states_checked += evaluated
+            counter.distance_queries += bounded
             if failed and (not last_valid or bad == 0.0):
                 return False, 0.0
             pairs, spans = self._hard_pair[:hard], self._hard_span[:hard]
@@ -230,13 +233,12 @@ class MotionCertifier:
             pairs = np.arange(self.pair_count)
             spans = np.tile([0.0, 1.0, -np.inf, -np.inf], (self.pair_count, 1))
         if len(pairs):
-            exact_failed, bad = self._exact_phase(a, b, pairs, spans, start, end, floor, last_valid, bad)
-            failed = failed or exact_failed
+            failed, bad = self._exact_phase(a, b, pairs, spans, start, end, settle, last_valid, failed, bad)
         if failed:
             return False, bad if last_valid else 0.0
         return True, 1.0
 
-    def _arguments(self, a: np.ndarray, b: np.ndarray, start: int, end: int, floor: float, stop: bool) -> tuple:
+    def _arguments(self, a: np.ndarray, b: np.ndarray, start: int, end: int, settle: float, stop: bool) -> tuple:
         """The arguments of :func:`~ompl_balance.collision.advancement.advance` for the edge ``a -> b``."""
         memory = self._memory
         return (
@@ -247,7 +249,8 @@ class MotionCertifier:
             self._model,
             self.clearance,
             self.handover,
-            floor,
+            MIN_TRAVEL,
+            settle,
             stop,
             memory.ends(start),
             memory.ends(end),
@@ -318,19 +321,21 @@ class MotionCertifier:
         spans: np.ndarray,
         start: int,
         end: int,
-        floor: float,
+        settle: float,
         last_valid: bool,
+        failed: bool,
         bad: float,
     ) -> tuple[bool, float]:
         """Certify the hard segments (pair, (t0, t1, d0, d1)) with FCL.
 
-        Returns whether one failed and the new ``bad`` (the edge certified on
-        ``[0, bad]``); without ``last_valid`` it returns at the first failure.
+        ``failed`` and ``bad``: what the compiled phase found (the edge certified on
+        ``[0, bad]`` but for the hard segments). Returns them updated; without
+        ``last_valid`` it returns at the first failure. Segments reaching a failure are
+        refined to ``settle`` metres of travel only.
         """
         clearance, speed, delta = self.clearance, self._speed, b - a
         poses_at: dict[float, np.ndarray] = {}
         exact: dict[tuple[int, float], float] = {}
-        failed = False
 
         def poses(t: float) -> np.ndarray:
             if t not in poses_at:
@@ -375,7 +380,7 @@ class MotionCertifier:
                     if not last_valid:
                         return True, 0.0
                     bad = min(bad, t)
-            if travel < floor or t0 >= bad:
+            if travel < MIN_TRAVEL or t0 >= bad or (failed and t1 >= bad and travel < settle):
                 failed = True
                 if not last_valid:
                     return True, 0.0
@@ -440,4 +445,44 @@ def certify_states(checker: CollisionChecker, states: np.ndarray, clearance: flo
         certified_fraction=fraction if first_bad is not None else 1.0,
         smallest_clearance=smallest,
         clearance=clearance,
+    )
+
+
+def warm_up() -> None:
+    """Compile the advancement kernel, or load it from numba's cache, for the argument types
+    every certifier passes (a robot without geometry stands in), as
+    :func:`~ompl_balance.collision.screening.warm_up` does for the checker's kernels."""
+    chain, volumes = stand_ins()
+    model = Model(
+        parts=pack_parts([]),
+        obstacle_centre=np.zeros((0, 3)),
+        obstacle_radius=np.zeros(0),
+        environment_weight=np.zeros((0, 1)),
+        self_weight=np.zeros((0, 1)),
+        fixed=np.zeros(0),
+        solid=np.zeros(0, dtype=bool),
+        joint_lower=np.zeros(1),
+        joint_upper=np.zeros(1),
+    )
+    memory = _EndMemory(2, 0)
+    q = np.zeros(1)
+    hard_pair, hard_span = np.zeros(1, dtype=np.int64), np.zeros((1, 4))
+    ends = memory.ends(0)
+    advance(
+        q,
+        q,
+        chain,
+        volumes,
+        model,
+        0.0,
+        0.01,
+        MIN_TRAVEL,
+        MIN_TRAVEL,
+        True,
+        ends,
+        ends,
+        np.zeros((0, 3)),
+        q[:0],
+        hard_pair,
+        hard_span,
     )

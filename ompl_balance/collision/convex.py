@@ -251,15 +251,15 @@ def distance_bounds(
         v = (1.0, 0.0, 0.0)
     simplex = np.empty((4, 3))
     n = 0
-    lower = -np.inf
+    lower, upper = -np.inf, np.inf  # upper: the nearest point of D seen (the start direction is none)
     for _ in range(GJK_ITERATIONS):
         w = _sub(
             _support(parts, first, first_poses, first_body, (-v[0], -v[1], -v[2])),
             _support(parts, second, second_poses, second_body, v),
         )
-        length = math.sqrt(_dot(v, v))
-        lower = max(lower, _dot(v, w) / length)
-        if lower >= enough or length - lower <= GJK_TOLERANCE:
+        lower = max(lower, _dot(v, w) / math.sqrt(_dot(v, v)))
+        upper = min(upper, math.sqrt(_dot(w, w)))
+        if lower >= enough or upper - lower <= GJK_TOLERANCE:
             break
         for k in range(n):
             if simplex[k, 0] == w[0] and simplex[k, 1] == w[1] and simplex[k, 2] == w[2]:
@@ -271,5 +271,6 @@ def distance_bounds(
         if n == 4 or _dot(closest, closest) <= GJK_TOLERANCE * GJK_TOLERANCE:
             return min(lower, 0.0), 0.0
         v = closest
+        upper = min(upper, math.sqrt(_dot(v, v)))
     directions[row, 0], directions[row, 1], directions[row, 2] = v
-    return lower, math.sqrt(_dot(v, v))
+    return lower, upper

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import fcl
 import numpy as np
+import scipy.spatial
 import trimesh
 
 from .cache import cached_arrays
@@ -99,16 +100,18 @@ class Shape:
         return self.mesh
 
     def hull_vertices(self) -> np.ndarray | None:
-        """Vertices (m, 3) of a mesh's convex hull (``None`` for primitives); computed once."""
+        """Vertices (m, 3) of a mesh's convex hull (``None`` for primitives); computed once.
+
+        Only the hull matters for support functions, so this is what the distance bounds
+        use. Flat or degenerate meshes keep all their (distinct) vertices.
+        """
         if self.mesh is None:
             return None
-        known = _HULL_OF.get(self)
-        if known is None:
-            hull = self.mesh.convex_hull
-            known = (np.array(hull.vertices, dtype=float), _solid_mesh(self.mesh, hull))
-            known[0].setflags(write=False)
-            _HULL_OF[self] = known
-        return known[0]
+        if self not in _HULL_OF:
+            vertices, solid = _convex_hull(self.mesh)
+            vertices.setflags(write=False)
+            _HULL_OF[self] = vertices, solid
+        return _HULL_OF[self][0]
 
     @property
     def convex(self) -> bool:
@@ -121,7 +124,7 @@ class Shape:
         if self.mesh is None:
             return True
         self.hull_vertices()
-        return _HULL_OF[self][1]
+        return bool(_HULL_OF[self][1])
 
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         """An oriented box containing the shape: ``(pose (4, 4) in the shape frame, half extents (3,))``."""
@@ -188,13 +191,29 @@ class Shape:
 _HULL_OF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # Shape -> (hull vertices, convex)
 
 
-def _solid_mesh(mesh: trimesh.Trimesh, hull: trimesh.Trimesh) -> bool:
-    """Whether ``mesh`` (vertices merged) is closed and fills its convex ``hull`` to 0.1 % of its volume."""
+def _convex_hull(mesh: trimesh.Trimesh) -> tuple[np.ndarray, bool]:
+    """The vertices of ``mesh``'s convex hull and whether the mesh is closed and fills it.
+
+    The hull (Qhull) is checked to hold every vertex of the mesh, to 1e-9 m; a hull that
+    fails the check or has no volume is replaced by all the mesh's vertices (the same
+    convex set, only slower to search).
+    """
+    points = np.unique(np.asarray(mesh.vertices, dtype=float), axis=0)
+    try:
+        hull = scipy.spatial.ConvexHull(points)
+    except scipy.spatial.QhullError:  # flat or degenerate
+        return points, False
+    outside = max(
+        float((chunk @ hull.equations[:, :3].T + hull.equations[:, 3]).max())
+        for chunk in np.array_split(points, max(1, len(points) // 512))
+    )
+    if not (hull.volume > 0.0 and outside <= 1e-9):
+        return points, False
     merged = mesh.copy()
     merged.merge_vertices()
-    if not merged.is_watertight:
-        return False
-    return bool(abs(abs(merged.volume) - hull.volume) <= 1e-3 * hull.volume)
+    # closed and of the hull's volume (to 0.1 %): the triangles are the hull's surface but for dents
+    solid = bool(merged.is_watertight and abs(abs(merged.volume) - hull.volume) <= 1e-3 * hull.volume)
+    return points[hull.vertices], solid
 
 
 class _BoxPiece:

@@ -344,11 +344,9 @@ def screen(q, chain, volumes, poses, obstacle_hits, self_hits):  # pragma: no co
     return maybe
 
 
-def warm_up() -> None:
-    """Compile the kernels, or load them from numba's cache, for the argument types every
-    robot's checker uses (a robot with no geometry stands in): about half a second,
-    spent here instead of in a robot's first check. The benchmark runner's forkserver
-    does this once (:mod:`ompl_balance.collision.warm_kernels`), so run processes start warm."""
+def stand_ins() -> tuple[Chain, Volumes]:
+    """A one-joint chain and the volumes of a robot without geometry: arrays of the types
+    real robots pass, for compiling the kernels ahead of use."""
     integers, reals = (lambda *shape: np.zeros(shape, dtype=np.int64)), (lambda *shape: np.zeros(shape))
     chain = Chain(
         integers(1),
@@ -381,6 +379,15 @@ def warm_up() -> None:
         integers(0),
         np.zeros(0, dtype=bool),
     )
-    q, poses = reals(1, 1), reals(1, 2, 4, 4)
+    return chain, volumes
+
+
+def warm_up() -> None:
+    """Compile the kernels, or load them from numba's cache, for the argument types every
+    robot's checker uses (a robot with no geometry stands in): about half a second,
+    spent here instead of in a robot's first check. The benchmark runner's forkserver
+    does this once (:mod:`ompl_balance.collision.warm_kernels`), so run processes start warm."""
+    chain, volumes = stand_ins()
+    q, poses = np.zeros((1, 1)), np.zeros((1, 2, 4, 4))
     screen(q, chain, volumes, poses, np.zeros((1, 0, 0), dtype=bool), np.zeros((1, 0), dtype=bool))
     _chain_poses_batch(q, chain, poses)
