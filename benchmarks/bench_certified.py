@@ -22,6 +22,7 @@ Run: ``python benchmarks/bench_certified.py [--problems 10] [--runs 3] [--time-l
 from __future__ import annotations
 
 import argparse
+import itertools
 import platform
 import statistics
 import time
@@ -44,7 +45,7 @@ VALIDATORS = ("certified", "discrete")
 def dense_collisions(reference: CollisionChecker, states: np.ndarray, step: float) -> int:
     """Number of segments of the path ``states`` (n, dof) with a colliding state at most ``step`` apart."""
     colliding = 0
-    for a, b in zip(states[:-1], states[1:]):
+    for a, b in itertools.pairwise(states):
         count = max(1, int(np.ceil(np.abs(b - a).max() / step)))
         t = np.arange(count + 1) / count
         if not reference.check(a + t[:, None] * (b - a)).all():

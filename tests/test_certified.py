@@ -8,6 +8,7 @@ what certification rests on: travel bounds, GJK distance bounds on convex hulls,
 advancement, FCL distances.
 """
 
+import itertools
 from pathlib import Path
 
 import fcl
@@ -473,7 +474,7 @@ def plan_and_recheck(scenario, index, planner_class, simplify=True):
     for path in paths:
         states = np.array([path.getState(i)[0 : robot.dof] for i in range(path.getStateCount())])
         assert certify_path(checker, states).certified
-        for a, b in zip(states[:-1], states[1:]):
+        for a, b in itertools.pairwise(states):
             assert dense_first_collision(oracle, a, b) is None
     return ss
 

@@ -205,7 +205,7 @@ def table_span_free(
         index = volumes.table_start[table]
         for k in range(2):
             u = low[k] + middle * slope[k]
-            cell = int(math.floor(u))
+            cell = math.floor(u)
             if cell == cells[k] and u <= cells[k] + 1e-9:
                 cell = cells[k] - 1  # the upper bound itself: in the last (closed) cell
             if cell < 0 or cell >= cells[k]:
@@ -332,10 +332,9 @@ def advance(
             need = travel + 2.0 * clearance
             if seg_lower[e, 0] + seg_lower[e, 1] > need:
                 continue
-            self_pair = pair - obstacles * geometries
-            if self_pair >= 0 and volumes.pair_table[self_pair] >= 0:
-                if table_span_free(a, delta, t0, t0 + width, chain, volumes, volumes.pair_table[self_pair]):
-                    continue
+            table = volumes.pair_table[pair - obstacles * geometries] if pair >= obstacles * geometries else -1
+            if table >= 0 and table_span_free(a, delta, t0, t0 + width, chain, volumes, table):
+                continue
             # sharpen the end bounds with GJK, the smaller first, unless halving with the
             # sphere bounds will do in a level or two
             first = 0 if seg_lower[e, 0] <= seg_lower[e, 1] else 1

@@ -53,13 +53,12 @@ from collections import deque
 from dataclasses import dataclass
 
 import fcl
-import numba
 import numpy as np
 
 from .advancement import DISTANCE_TOLERANCE, Ends, Model, advance, hull_bounds, sphere_bounds
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
-from .screening import stand_ins
+from .screening import entry_point, stand_ins
 from .travel import travel_weights
 
 #: A segment whose travel bound is below this (m) and is still not certified is not cut
@@ -152,9 +151,7 @@ class MotionCertifier:
         # the compiled phase is called without numba's type dispatch (several microseconds
         # of an edge's few tens): the argument types are fixed here
         lower = np.ascontiguousarray(robot.lower, dtype=float)
-        arguments = self._arguments(lower, lower, 0, 0, MIN_TRAVEL, stop=True)
-        advance(*arguments)
-        self._advance = advance.overloads[tuple(numba.typeof(x) for x in arguments)].entry_point
+        self._advance = entry_point(advance, self._arguments(lower, lower, 0, 0, MIN_TRAVEL, stop=True))
 
     def _build_model(self) -> Model:
         robot, obstacles = self._robot, self.checker.environment.obstacles
@@ -272,7 +269,7 @@ class MotionCertifier:
         pairs = np.arange(self.pair_count)
         lower = np.empty(self.pair_count)
         sphere_bounds(poses, volumes, self._model, pairs, lower)
-        for pair in pairs:
+        for pair in range(self.pair_count):
             lower[pair] = max(lower[pair], hull_bounds(pair, poses, volumes, self._model, warm, self._identity, 0.0)[0])
         best = np.inf
         for pair in np.argsort(lower):

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NoReturn
 from xml.parsers import expat
 
 #: Joint types the robot layer moves or folds (``planar`` and ``floating`` are not supported).
@@ -66,7 +67,7 @@ class _Problems:
     def __init__(self, path: Path):
         self.path = path
 
-    def fail(self, node: _Node, message: str) -> None:
+    def fail(self, node: _Node, message: str) -> NoReturn:
         raise ValueError(f"URDF {self.path}, line {node.line}: {message}")
 
     def numbers(self, owner: str, node: _Node, attribute: str, count: int, required: bool = True) -> list[float] | None:
@@ -173,12 +174,12 @@ def check_urdf(path: str | Path) -> None:
             robot, f"the links must form one tree with one root link; links without a parent joint: {roots or 'none'}"
         )
     for name in links:  # every link reaches the root: no cycles
-        seen, link = set(), name
-        while link in parent_of:
-            if link in seen:
-                problems.fail(joints[parent_of[link]], f"the joints form a cycle through link {link!r}")
-            seen.add(link)
-            link = next(c.attributes["link"] for c in joints[parent_of[link]].children if c.tag == "parent")
+        seen, current = set(), name
+        while current in parent_of:
+            if current in seen:
+                problems.fail(joints[parent_of[current]], f"the joints form a cycle through link {current!r}")
+            seen.add(current)
+            current = next(c.attributes["link"] for c in joints[parent_of[current]].children if c.tag == "parent")
 
 
 def _check_collision(problems: _Problems, link: _Node, collision: _Node) -> None:
