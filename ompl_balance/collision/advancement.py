@@ -71,9 +71,10 @@ class Model(NamedTuple):
     joint_upper: np.ndarray
 
 
-class Ends(NamedTuple):
-    """Bounds known at one configuration, per pair: ``lower`` (NaN: unknown), ``upper``
-    (inf: unknown) and ``final`` (the lower bound cannot be sharpened)."""
+class Remembered(NamedTuple):
+    """Bounds known at remembered configurations, one row each, (configurations, pairs):
+    ``lower`` (NaN: unknown), ``upper`` (inf: unknown) and ``final`` (the lower bound cannot
+    be sharpened)."""
 
     lower: np.ndarray
     upper: np.ndarray
@@ -242,8 +243,9 @@ def advance(
     floor: float,
     settle: float,
     stop: bool,
-    start: Ends,
-    end: Ends,
+    remembered: Remembered,
+    start: int,
+    end: int,
     warm: np.ndarray,
     speed: np.ndarray,
     hard_pair: np.ndarray,
@@ -255,8 +257,8 @@ def advance(
     bound below ``floor`` (m) fails the edge; ``stop``: return at the first failure;
     otherwise a segment reaching a failure found earlier is refined to ``settle`` (m) of
     travel only (where the last certified fraction is wanted, not a certificate).
-    ``start`` and ``end`` are the bounds known at ``a`` and ``b`` and receive what is
-    computed there. ``warm`` (pairs, 3): each pair's last GJK direction. Writes each pair's
+    ``remembered`` rows ``start`` and ``end`` hold the bounds known at ``a`` and ``b`` and
+    receive what is computed there. ``warm`` (pairs, 3): each pair's last GJK direction. Writes each pair's
     travel bound per unit ``t`` into ``speed``. Hard segments: pair ``hard_pair[i]``,
     ``hard_span[i]`` = (t0, t1, d0, d1).
 
@@ -306,14 +308,14 @@ def advance(
     seg_lower = np.empty((pairs, 2))
     seg_final = np.zeros((pairs, 2), dtype=np.bool_)
     spheres = np.empty(pairs)
-    for side, known in enumerate((start, end)):
+    for side, row in enumerate((start, end)):
         sphere_bounds(point_poses[side], volumes, model, seg_pair, spheres)
         for pair in range(pairs):
             seg_lower[pair, side] = spheres[pair]
-            if not math.isnan(known.lower[pair]):
-                seg_lower[pair, side] = max(spheres[pair], known.lower[pair])
-                seg_final[pair, side] = known.final[pair]
-                if model.solid[pair] and known.upper[pair] <= contact:
+            if not math.isnan(remembered.lower[row, pair]):
+                seg_lower[pair, side] = max(spheres[pair], remembered.lower[row, pair])
+                seg_final[pair, side] = remembered.final[row, pair]
+                if model.solid[pair] and remembered.upper[row, pair] <= contact:
                     failed = True
                     bad = min(bad, float(side))
     if failed and stop:
@@ -350,9 +352,9 @@ def advance(
                 seg_lower[e, side] = max(seg_lower[e, side], lower)
                 seg_final[e, side] = lower < target
                 if point < 2:
-                    known = start if point == 0 else end
-                    known.lower[pair], known.final[pair] = seg_lower[e, side], seg_final[e, side]
-                    known.upper[pair] = min(known.upper[pair], upper)
+                    row = start if point == 0 else end
+                    remembered.lower[row, pair], remembered.final[row, pair] = seg_lower[e, side], seg_final[e, side]
+                    remembered.upper[row, pair] = min(remembered.upper[row, pair], upper)
                 if model.solid[pair] and upper <= contact:
                     failed = True
                     if stop:

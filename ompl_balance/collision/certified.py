@@ -55,7 +55,7 @@ from dataclasses import dataclass
 import fcl
 import numpy as np
 
-from .advancement import DISTANCE_TOLERANCE, Ends, Model, advance, hull_bounds, sphere_bounds
+from .advancement import DISTANCE_TOLERANCE, Model, Remembered, advance, hull_bounds, sphere_bounds
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
 from .screening import entry_point, stand_ins
@@ -79,9 +79,9 @@ class _EndMemory:
     """
 
     def __init__(self, size: int, pairs: int):
-        self.lower = np.full((size, pairs), np.nan)
-        self.upper = np.full((size, pairs), np.inf)
-        self.final = np.zeros((size, pairs), dtype=bool)
+        self.bounds = Remembered(
+            np.full((size, pairs), np.nan), np.full((size, pairs), np.inf), np.zeros((size, pairs), dtype=bool)
+        )
         self.exact: list[dict[int, float]] = [{} for _ in range(size)]  # pair -> FCL distance
         self._rows: dict[bytes, int] = {}
         self._keys: list[bytes | None] = [None] * size
@@ -98,12 +98,9 @@ class _EndMemory:
             if old is not None:
                 del self._rows[old]
             self._keys[row], self._rows[key] = key, row
-            self.lower[row], self.upper[row], self.final[row] = np.nan, np.inf, False
+            self.bounds.lower[row], self.bounds.upper[row], self.bounds.final[row] = np.nan, np.inf, False
             self.exact[row].clear()
         return row
-
-    def ends(self, row: int) -> Ends:
-        return Ends(self.lower[row], self.upper[row], self.final[row])
 
 
 class MotionCertifier:
@@ -148,6 +145,8 @@ class MotionCertifier:
         self._hard_pair = np.empty(16, dtype=np.int64)
         self._hard_span = np.empty((16, 4))
         self._memory = _EndMemory(max(2, remembered), self.pair_count)
+        self._model_arguments = (robot.chain, checker._volumes, self._model, self.clearance, self.handover, MIN_TRAVEL)
+        self._scratch = (self._warm, self._speed, self._hard_pair, self._hard_span)
         # the compiled phase is called without numba's type dispatch (several microseconds
         # of an edge's few tens): the argument types are fixed here
         lower = np.ascontiguousarray(robot.lower, dtype=float)
@@ -212,9 +211,12 @@ class MotionCertifier:
         start, end = self._memory.row(a), self._memory.row(b)
         settle = max(MIN_TRAVEL, LAST_VALID_TRAVEL) if last_valid else MIN_TRAVEL
         if self.checker.prefilter:
-            failed, bad, hard, evaluated, bounded, self._hard_pair, self._hard_span = self._advance(
+            failed, bad, hard, evaluated, bounded, hard_pair, hard_span = self._advance(
                 *self._arguments(a, b, start, end, settle, stop=not last_valid)
             )
+            if hard_pair is not self._hard_pair:  # grown
+                self._hard_pair, self._hard_span = hard_pair, hard_span
+                self._scratch = (self._warm, self._speed, self._hard_pair, self._hard_span)
             counter.states_checked += evaluated
             counter.distance_queries += bounded
             if failed and (not last_valid or bad == 0.0):
@@ -237,25 +239,7 @@ class MotionCertifier:
 
     def _arguments(self, a: np.ndarray, b: np.ndarray, start: int, end: int, settle: float, stop: bool) -> tuple:
         """The arguments of :func:`~ompl_balance.collision.advancement.advance` for the edge ``a -> b``."""
-        memory = self._memory
-        return (
-            a,
-            b,
-            self._robot.chain,
-            self.checker._volumes,
-            self._model,
-            self.clearance,
-            self.handover,
-            MIN_TRAVEL,
-            settle,
-            stop,
-            memory.ends(start),
-            memory.ends(end),
-            self._warm,
-            self._speed,
-            self._hard_pair,
-            self._hard_span,
-        )
+        return (a, b, *self._model_arguments, settle, stop, self._memory.bounds, start, end, *self._scratch)
 
     def closest(self, q: np.ndarray) -> float:
         """The smallest FCL distance (m) between the collision pairs at configuration ``q`` (dof,).
@@ -461,25 +445,7 @@ def warm_up() -> None:
         joint_lower=np.zeros(1),
         joint_upper=np.zeros(1),
     )
-    memory = _EndMemory(2, 0)
     q = np.zeros(1)
     hard_pair, hard_span = np.zeros(1, dtype=np.int64), np.zeros((1, 4))
-    ends = memory.ends(0)
-    advance(
-        q,
-        q,
-        chain,
-        volumes,
-        model,
-        0.0,
-        0.01,
-        MIN_TRAVEL,
-        MIN_TRAVEL,
-        True,
-        ends,
-        ends,
-        np.zeros((0, 3)),
-        q[:0],
-        hard_pair,
-        hard_span,
-    )
+    memory = _EndMemory(2, 0).bounds
+    advance(q, q, chain, volumes, model, 0.0, 0.01, MIN_TRAVEL, MIN_TRAVEL, True, memory, 0, 1, np.zeros((0, 3)), q[:0], hard_pair, hard_span)
