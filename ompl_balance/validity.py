@@ -76,6 +76,7 @@ class MotionValidator(ob.MotionValidator):
     """
 
     def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker):
+        _check_dimension(si, checker)
         super().__init__(si)
         self.checker = checker
         self._space = si.getStateSpace()
@@ -150,22 +151,24 @@ class CertifiedMotionValidator(ob.MotionValidator):
     An edge ``s1 -> s2`` is valid when the whole straight line ``s1 + t (s2 - s1)``,
     ``t in [0, 1]``, in joint space is certified: every collision pair of ``checker``'s
     model (link collision geometry against the environment's obstacles, and the enabled
-    self-collision pairs) stays more than ``clearance`` metres apart, by conservative
-    advancement with sphere and FCL distance lower bounds and a bound on how far the
-    links travel (:class:`~ompl_balance.collision.certified.MotionCertifier`). It never
-    calls an edge with a colliding configuration valid; it may reject an edge that
-    passes within about :data:`~ompl_balance.collision.certified.DISTANCE_TOLERANCE` of
-    the clearance. What is not certified: anything off the straight line (a controller's
+    self-collision pairs) stays more than ``clearance`` metres apart. The proof is
+    conservative advancement: distance lower bounds (bounding spheres, GJK on convex hulls,
+    FCL's exact distance) against a bound on how far the links travel
+    (:class:`~ompl_balance.collision.certified.MotionCertifier`). It never calls an edge
+    with a colliding configuration valid; it may reject one that passes within
+    :data:`~ompl_balance.collision.advancement.DISTANCE_TOLERANCE` (10 micrometres) of the
+    clearance. What is not certified: anything off the straight line (a controller's
     tracking error), geometry the checker does not model (visual meshes, SRDF-disabled
     pairs), obstacles that move.
 
     States with a non-finite value or outside the robot's joint bounds make an edge
     invalid (OMPL's C++ caller gets ``false``, not an exception). Work is counted in the
     checker's counter: one motion per edge, the configurations evaluated as states, and
-    FCL distance queries.
+    the distance queries (GJK bounds and FCL distances).
     """
 
     def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker, clearance: float = 0.0):
+        _check_dimension(si, checker)
         super().__init__(si)
         self.checker = checker
         self.certifier = MotionCertifier(checker, clearance)
@@ -203,6 +206,14 @@ class CertifiedMotionValidator(ob.MotionValidator):
         self.checker.reset_counters()
 
 
+def _check_dimension(si: ob.SpaceInformation, checker: CollisionChecker) -> None:
+    dimension = si.getStateDimension()
+    if dimension != checker.robot.dof:
+        raise ValueError(
+            f"space has dimension {dimension}, robot {checker.robot.name!r} has {checker.robot.dof} joints"
+        )
+
+
 def setup_robot(
     ss_or_si: og.SimpleSetup | ob.SpaceInformation,
     checker: CollisionChecker,
@@ -222,11 +233,7 @@ def setup_robot(
     if motion == "discrete" and clearance != 0.0:
         raise ValueError(f"clearance={clearance} needs motion='certified' (the discrete validator keeps none)")
     si = ss_or_si.getSpaceInformation() if isinstance(ss_or_si, og.SimpleSetup) else ss_or_si
-    dimension = si.getStateDimension()
-    if dimension != checker.robot.dof:
-        raise ValueError(
-            f"space has dimension {dimension}, robot {checker.robot.name!r} has {checker.robot.dof} joints"
-        )
+    _check_dimension(si, checker)
     validity = StateValidityChecker(si, checker)
     validator: CertifiedMotionValidator | MotionValidator
     if motion == "certified":

@@ -18,32 +18,49 @@ move, not a controller's tracking error.
 
 Method
 ------
-Conservative advancement with three ingredients, each a module of its own:
+Conservative advancement (Schwarzer, Saha and Latombe, "Adaptive dynamic collision
+checking for single and multiple articulated robots in complex environments", IEEE T-RO
+21(3), 2005) with three ingredients, each in a module of its own:
 
-* a **travel bound** (:mod:`ompl_balance.collision.travel`): along a segment
-  ``[t0, t1]`` no point of a link moves farther than ``(t1 - t0) sum_j |b_j - a_j| W[g, j]``,
-  where ``W[g, j]`` sums, over the joints upstream of the geometry driven by active joint
-  ``j``, bounds on the distance of the geometry from the joint axis that hold in every
-  configuration (Schwarzer, Saha and Latombe, "Adaptive dynamic collision checking for
-  single and multiple articulated robots in complex environments", IEEE T-RO 2005);
-  self pairs count the relative motion, the joints below their common ancestor only;
+* a **travel bound** (:mod:`ompl_balance.collision.travel`). Along the edge a point ``p``
+  of a link moves with velocity ``sum_k v_k' w_k(p)``: joint ``k`` upstream of the link
+  changes its value at rate ``v_k'``, and ``w_k(p)`` is ``axis_k x (p - o_k)`` (``o_k`` on
+  the axis) for a revolute joint, ``axis_k`` for a prismatic one. So ``|dp/dt| <=
+  sum_k |v_k'| r_k`` where ``r_k`` bounds the distance of ``p`` from joint ``k``'s axis
+  in *every* configuration (1 for a prismatic joint), and over ``[t0, t1]`` no point
+  travels farther than ``(t1 - t0) sum_j |b_j - a_j| W[g, j]``, with ``W[g, j]`` the sum of
+  ``|m_k| r_k`` over the joints ``k`` of geometry ``g``'s chain driven by active joint
+  ``j`` (a mimic joint ``v_k = m_k q_j + c_k``). ``r_k`` is the largest distance of the
+  geometry from the axis when it hangs off joint ``k``'s own body, and otherwise the
+  component across the axis of the first link offset below the joint, plus the lengths
+  of the further offsets (prismatic ones at the end of their range), plus the geometry's
+  radius about its body frame origin. A self pair counts the joints below the two
+  geometries' lowest common ancestor body only, both geometries' weights summed: the
+  joints above move both rigidly and leave their distance alone;
 * **distance lower bounds** at a configuration (:mod:`ompl_balance.collision.convex`):
-  bounding spheres first, then GJK on the convex parts (a mesh's convex hull, which
-  contains the mesh), whose separating-plane value is a lower bound at every iteration;
-* **advancement** (:mod:`ompl_balance.collision.advancement`): a pair is certified on
-  ``[t0, t1]`` when its bounds at the ends exceed twice the clearance plus its travel
-  bound; otherwise the segment is halved. Pairs are independent, so a pair far from
-  contact needs a bound or two for the whole edge.
+  bounding spheres first (a link geometry's sphere against an obstacle's box or sphere,
+  two links' spheres), then GJK on the convex parts (a mesh's convex hull, which contains
+  the mesh), whose separating-plane value ``v . w / |v|`` is a lower bound at every
+  iteration, and last FCL's exact distance;
+* **advancement** (:mod:`ompl_balance.collision.advancement`): with lower bounds ``d0``,
+  ``d1`` at ``t0``, ``t1`` and travel bound ``V`` per unit ``t``, a pair stays
+  ``max(d0 - V (t - t0), d1 - V (t1 - t)) >= (d0 + d1 - V (t1 - t0)) / 2`` apart on the
+  segment, so it is certified there when ``d0 + d1 - 2 clearance > V (t1 - t0)``;
+  otherwise the segment is halved and the midpoint bounded. Pairs are independent, so a
+  pair far from contact needs a bound or two for the whole edge while a close one is cut
+  finely, and configurations at the ends of an edge keep their bounds for the next edge.
 
-Pairs with a non-convex mesh (whose hull may touch where the mesh does not) are finished
-with FCL (:meth:`MotionCertifier._exact_phase`): when a segment of theirs with at most
-``handover`` metres of travel is still uncertified, a collision test at its midpoint and
-then FCL's exact distances, halving again. Self pairs with a certified-free table are
-certified wherever their straight line in the table's two joint values crosses free cells.
+A pair whose convex parts are its FCL model (primitives, convex meshes) is decided by
+GJK: an upper bound within the tolerance of the clearance is a contact. Pairs with a
+non-convex mesh (whose hull may touch where the mesh does not) are finished with FCL
+(:meth:`MotionCertifier._exact_phase`): when a segment of theirs with at most ``handover``
+metres of travel is still uncertified, a collision test at its midpoint, then FCL's exact
+distances, halving again. Self pairs with a certified-free table are certified wherever
+their straight line in the table's two joint values crosses free cells.
 
-Termination: a segment with a travel bound under ``MIN_TRAVEL`` metres that is still not
-certified makes the edge uncertified, and contacts are decided with the tolerance above,
-so grazing edges end (rejected) after a bounded number of halvings.
+Termination: a segment with a travel bound under :data:`MIN_TRAVEL` metres that is still
+not certified makes the edge uncertified, and contacts are decided with the tolerance
+above, so grazing edges end (rejected) after a bounded number of halvings.
 """
 
 from __future__ import annotations
