@@ -465,4 +465,22 @@ def warm_up() -> None:
     q = np.zeros(1)
     hard_pair, hard_span = np.zeros(1, dtype=np.int64), np.zeros((1, 4))
     memory = _EndMemory(2, 0).bounds
-    advance(q, q, chain, volumes, model, 0.0, 0.01, MIN_TRAVEL, MIN_TRAVEL, True, memory, 0, 1, np.zeros((0, 3)), q[:0], hard_pair, hard_span)
+    advance(
+        q,
+        q,
+        chain,
+        volumes,
+        model,
+        0.0,
+        0.01,
+        MIN_TRAVEL,
+        MIN_TRAVEL,
+        True,
+        memory,
+        0,
+        1,
+        np.zeros((0, 3)),
+        q[:0],
+        hard_pair,
+        hard_span,
+    )
