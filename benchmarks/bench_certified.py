@@ -12,8 +12,10 @@ Every returned path is re-checked independently: a fresh checker without pre-fil
 ``--step`` rad apart in every joint along each segment (default 0.005 rad). Per
 scenario, planner and validator it prints the success rate, the median planning time
 (failed runs count with their time, i.e. the limit), how many returned paths collide in
-the re-check, and the work per edge: configurations evaluated, FCL distance queries; and
-the ratios certified / discrete of the median times and of the total planning time.
+the re-check, the median number of edges checked per run, the planning time per edge
+checked, the work per edge (configurations evaluated; distance queries: GJK bounds on
+convex hulls and FCL distances), and the ratios certified / discrete of the median times
+and of the total planning time.
 
 Run: ``python benchmarks/bench_certified.py [--problems 10] [--runs 3] [--time-limit 10]
 [--scenarios table_pick,box] [--step 0.005]``
@@ -26,9 +28,9 @@ import itertools
 import platform
 import statistics
 import time
+from importlib import metadata
 
 import numpy as np
-import ompl
 from ompl import geometric as og
 from ompl import util as ou
 
@@ -95,13 +97,13 @@ def main() -> None:
     print(
         f"VAMP's Panda, first {args.problems} problems per scenario, {args.runs} runs each, "
         f"{args.time_limit:g} s limit; re-check every {args.step:g} rad (FCL, no pre-filter); "
-        f"Python {platform.python_version()}, ompl {getattr(ompl, '__version__', '?')}\n"
+        f"Python {platform.python_version()}, ompl {metadata.version('ompl')}\n"
     )
     print(
-        "| scenario | planner | validator | success | median time (ms) | colliding paths "
-        "| states / edge | distance queries / edge | time ratio (median) | time ratio (total) |"
+        "| scenario | planner | validator | success | median time (ms) | colliding paths | median edges "
+        "| time / edge (us) | states / edge | distance queries / edge | time ratio (median) | time ratio (total) |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     totals: dict[tuple[str, str], list[dict]] = {}
     for scenario in args.scenarios.split(","):
         problems = load_mbm(scenario, robot.joint_names)[: args.problems]
@@ -134,7 +136,8 @@ def _row(scenario: str, planner: str, motion: str, runs: list[dict], discrete: l
     ratio_total = sum(r["time"] for r in runs) / sum(r["time"] for r in discrete)
     return (
         f"| {scenario} | {planner} | {motion} | {len(solved)}/{len(runs)} | {median * 1e3:.1f} "
-        f"| {colliding}/{len(solved)} | {sum(r['states'] for r in runs) / motions:.1f} "
+        f"| {colliding}/{len(solved)} | {statistics.median(r['motions'] for r in runs):.0f} "
+        f"| {sum(r['time'] for r in runs) / motions * 1e6:.0f} | {sum(r['states'] for r in runs) / motions:.1f} "
         f"| {sum(r['distances'] for r in runs) / motions:.2f} | {ratio_median:.2f} | {ratio_total:.2f} |"
     )
 

@@ -73,8 +73,8 @@ class Model(NamedTuple):
 
 class Remembered(NamedTuple):
     """Bounds known at remembered configurations, one row each, (configurations, pairs):
-    ``lower`` (NaN: unknown), ``upper`` (inf: unknown) and ``final`` (the lower bound cannot
-    be sharpened)."""
+    ``lower`` (a row of NaN: a configuration not seen yet), ``upper`` (inf: unknown) and
+    ``final`` (the lower bound cannot be sharpened)."""
 
     lower: np.ndarray
     upper: np.ndarray
@@ -307,17 +307,15 @@ def advance(
     seg_point[:, 1] = 1
     seg_lower = np.empty((pairs, 2))
     seg_final = np.zeros((pairs, 2), dtype=np.bool_)
-    spheres = np.empty(pairs)
+    spheres, members, q = np.empty(pairs), np.empty(pairs, dtype=np.int64), np.empty(dof)
     for side, row in enumerate((start, end)):
-        sphere_bounds(point_poses[side], volumes, model, seg_pair, spheres)
+        if pairs > 0 and math.isnan(remembered.lower[row, 0]):  # a configuration not seen before
+            sphere_bounds(point_poses[side], volumes, model, seg_pair, remembered.lower[row])
         for pair in range(pairs):
-            seg_lower[pair, side] = spheres[pair]
-            if not math.isnan(remembered.lower[row, pair]):
-                seg_lower[pair, side] = max(spheres[pair], remembered.lower[row, pair])
-                seg_final[pair, side] = remembered.final[row, pair]
-                if model.solid[pair] and remembered.upper[row, pair] <= contact:
-                    failed = True
-                    bad = min(bad, float(side))
+            seg_lower[pair, side], seg_final[pair, side] = remembered.lower[row, pair], remembered.final[row, pair]
+            if model.solid[pair] and remembered.upper[row, pair] <= contact:
+                failed = True
+                bad = min(bad, float(side))
     if failed and stop:
         return failed, 0.0, hard, 2, 0, hard_pair, hard_span
     count, level = pairs, 0
@@ -400,10 +398,13 @@ def advance(
             point_poses = _grow(point_poses, points)
             middle = points - 1
             point_t[middle] = (k + 0.5) * width
-            chain_poses(a + point_t[middle] * delta, chain, point_poses[middle])
+            for j in range(dof):
+                q[j] = a[j] + point_t[middle] * delta[j]
+            chain_poses(q, chain, point_poses[middle])
             evaluated += 1
-            members = seg_pair[order[group:last]]
-            sphere_bounds(point_poses[middle], volumes, model, members, spheres)
+            for i in range(last - group):
+                members[i] = seg_pair[order[group + i]]
+            sphere_bounds(point_poses[middle], volumes, model, members[: last - group], spheres)
             for i in range(last - group):
                 e = order[group + i]
                 pair = seg_pair[e]

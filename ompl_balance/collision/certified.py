@@ -238,6 +238,8 @@ class MotionCertifier:
             counter.distance_queries += bounded
             if failed and (not last_valid or bad == 0.0):
                 return False, 0.0
+            if hard == 0:
+                return (False, bad) if failed else (True, 1.0)
             pairs, spans = self._hard_pair[:hard], self._hard_span[:hard]
         else:  # the reference: every pair over the whole edge with FCL only
             if not (self._inside(a) and self._inside(b)):
@@ -248,8 +250,7 @@ class MotionCertifier:
             failed, bad = False, 1.0
             pairs = np.arange(self.pair_count)
             spans = np.tile([0.0, 1.0, -np.inf, -np.inf], (self.pair_count, 1))
-        if len(pairs):
-            failed, bad = self._exact_phase(a, b, pairs, spans, start, end, settle, last_valid, failed, bad)
+        failed, bad = self._exact_phase(a, b, pairs, spans, start, end, settle, last_valid, failed, bad)
         if failed:
             return False, bad if last_valid else 0.0
         return True, 1.0
