@@ -208,7 +208,7 @@ def test_random_edges_panda(scenario):
 @pytest.mark.parametrize("scenario", ["arm3", *SCENARIOS])
 def test_random_edges_many(scenario):
     robot, environment = arm3_scene() if scenario == "arm3" else panda_scene(scenario)
-    edges = random_edges(robot, CollisionChecker(robot, environment), 1000, np.random.default_rng(5))
+    edges = random_edges(robot, CollisionChecker(robot, environment), 2000, np.random.default_rng(5))
     certified_count, free_count = check_edges(robot, environment, edges)
     assert certified_count >= 0.9 * free_count
 
@@ -251,6 +251,19 @@ def test_grazing_edges(scene):
     # 1e-5 rad apart in joint space: the colliding one is rejected, its lastValid prefix is free
     robot, environment = arm3_scene() if scene == "arm3" else panda_scene("table_pick")
     pairs = grazing_edges(robot, environment, 4, np.random.default_rng(6), longest=0.5)
+    check_edges(robot, environment, [edge for colliding, free, *_ in pairs for edge in (colliding, free)])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scenario", ["arm3", "self-collision", *SCENARIOS])
+def test_grazing_edges_many(scenario):
+    if scenario == "arm3":
+        robot, environment = arm3_scene()
+    elif scenario == "self-collision":
+        robot, environment = panda(), Environment()
+    else:
+        robot, environment = panda_scene(scenario)
+    pairs = grazing_edges(robot, environment, 20, np.random.default_rng(15), longest=0.5)
     check_edges(robot, environment, [edge for colliding, free, *_ in pairs for edge in (colliding, free)])
 
 
