@@ -18,6 +18,7 @@ planner made them do.
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 from ompl import base as ob
@@ -98,12 +99,17 @@ class MotionValidator(ob.MotionValidator):
         A state with a non-finite value makes the edge invalid with ``t = 0``.
         """
         self.checker.counter.motions_checked += 1
-        a, b = np.array(s1[0 : self._dof]), np.array(s2[0 : self._dof])
-        if not (np.isfinite(a).all() and np.isfinite(b).all()):
+        values = s2[0 : self._dof]
+        if not math.isfinite(sum(values)):
             return False, 0.0  # invalid, not an exception through OMPL's C++ caller
+        b = np.array(values)
         if last_valid is None and not self.checker.is_valid(b):
             # s2 alone on the single-state path first: it decides most colliding edges
             return False, 1.0
+        values = s1[0 : self._dof]
+        if not math.isfinite(sum(values)):
+            return False, 0.0
+        a = np.array(values)
         nd = self._space.validSegmentCount(s1, s2)
         t = np.arange(1, nd + 1) / nd
         if last_valid is None:

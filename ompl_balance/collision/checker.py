@@ -120,7 +120,8 @@ class WorkCounter:
 
     ``states_checked``: configurations evaluated (a state check, a state of a discrete
     edge, a configuration a certified edge was bounded at); ``motions_checked``: edges;
-    ``distance_queries``: FCL exact distance queries (certified motions only).
+    ``distance_queries``: distance bounds computed by GJK on convex hulls and FCL exact
+    distances (certified motions only).
     """
 
     def __init__(self) -> None:
