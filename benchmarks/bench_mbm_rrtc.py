@@ -1,23 +1,22 @@
 """Stock og.RRTConnect and BalancedRRTConnect on MotionBenchMaker Panda problems, one run.
 
-Both planners run through ``og.SimpleSetup`` with the package's collision checker and
-batched motion validator (``setup_robot``) on the four dev scenarios (table_pick,
-table_under_pick, box, bookshelf_small), VAMP's Panda model, all of a problem's goals
-as ``ob.GoalStates`` (any goal is a success). Per scenario and planner it prints the
-success rate, the median time (failed runs count with the time they took, i.e. the
-limit), the median states checked and motions checked, and their ratios to stock
-RRTConnect. Planners alternate problem by problem so the machine's slow phases hit both.
-Every returned path is re-checked state by state with a fresh checker.
+Both planners run through ``og.SimpleSetup`` with the package's collision checker and a
+motion validator (``setup_robot(..., motion=...)``: ``certified``, the default, or
+``discrete``) on the four dev scenarios (table_pick, table_under_pick, box,
+bookshelf_small), VAMP's Panda model, all of a problem's goals as ``ob.GoalStates`` (any
+goal is a success). Per scenario and planner it prints the success rate, the median time
+(failed runs count with the time they took, i.e. the limit), the median states checked
+and motions checked, and their ratios to stock RRTConnect. Planners alternate problem by
+problem so the machine's slow phases hit both. Every returned path is re-checked state
+by state with a fresh checker. (Certified against discrete: ``bench_certified.py``.)
 
-Run: ``python benchmarks/bench_mbm_rrtc.py [--data DIR] [--problems 10] [--time-limit 10]``
-(DIR defaults to ``<repo>/../shared/data``).
+Run: ``python benchmarks/bench_mbm_rrtc.py [--problems 10] [--time-limit 10] [--motion certified]``
 """
 
 from __future__ import annotations
 
 import argparse
 import statistics
-from pathlib import Path
 
 import numpy as np
 from ompl import geometric as og
@@ -26,16 +25,18 @@ from ompl import util as ou
 from ompl_balance import BalancedRRTConnect
 from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.core.counting import measured_solve
-from ompl_balance.validity import CollisionChecker
+from ompl_balance.validity import MOTION_VALIDATORS, CollisionChecker, setup_robot
 from ompl_balance.worlds.mbm import load_mbm
 
 SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small")
 PLANNERS = {"RRTConnect": og.RRTConnect, "BalancedRRTConnect": BalancedRRTConnect}
 
 
-def solve(robot, problem, make_planner, time_limit: float) -> dict:
+def solve(robot, problem, make_planner, time_limit: float, motion: str) -> dict:
     """One planning run; returns success, seconds, work counts and whether the path re-checks valid."""
-    ss = problem.simple_setup(robot)
+    checker = CollisionChecker(robot, problem.environment)
+    ss = problem.simple_setup(robot, checker)
+    setup_robot(ss, checker, motion=motion)
     ss.setPlanner(make_planner(ss.getSpaceInformation()))
     run = measured_solve(ss, time_limit)
     path_valid = None
@@ -54,9 +55,8 @@ def solve(robot, problem, make_planner, time_limit: float) -> dict:
 
 
 def main() -> None:
-    repo = Path(__file__).resolve().parents[1]
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data", type=Path, default=repo.parent / "shared" / "data")
+    parser.add_argument("--motion", choices=MOTION_VALIDATORS, default="certified", help="motion validator")
     parser.add_argument("--problems", type=int, default=10, help="first N problems of each scenario (default 10)")
     parser.add_argument("--time-limit", type=float, default=10.0, help="seconds per run (default 10)")
     parser.add_argument(
@@ -65,11 +65,11 @@ def main() -> None:
     args = parser.parse_args()
     ou.RNG.setSeed(1)
     ou.setLogLevel(ou.LOG_WARN)
-    robot = load_panda_vamp(args.data / "robots" / "panda_vamp")
+    robot = load_panda_vamp()
 
     print(
         f"Panda (VAMP model), first {args.problems} problems per scenario, one run each, time limit "
-        f"{args.time_limit:g} s; ratios are to stock RRTConnect's medians\n"
+        f"{args.time_limit:g} s, {args.motion} motions; ratios are to stock RRTConnect's medians\n"
     )
     print(
         "| scenario | planner | success | median time (ms) | median states checked | median motions "
@@ -77,11 +77,11 @@ def main() -> None:
     )
     print("|---|---|---|---|---|---|---|---|")
     for scenario in args.scenarios.split(","):
-        problems = load_mbm(args.data / "mbm" / "panda" / f"{scenario}.json", robot.joint_names)[: args.problems]
+        problems = load_mbm(scenario, robot.joint_names)[: args.problems]
         results = {name: [] for name in PLANNERS}
         for problem in problems:
             for name, make_planner in PLANNERS.items():
-                result = solve(robot, problem, make_planner, args.time_limit)
+                result = solve(robot, problem, make_planner, args.time_limit, args.motion)
                 if result["path_valid"] is False:
                     raise AssertionError(f"{scenario} problem {problem.id}: {name} returned a path in collision")
                 results[name].append(result)

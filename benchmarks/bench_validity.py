@@ -7,19 +7,20 @@ Compares, in one run on the same states and edges (and checks the answers agree)
   SRDF-enabled self-collision pairs) against the package's ``CollisionChecker``, called
   one state at a time (OMPL ``isValid``) and in edge-sized batches;
 * whole-edge validation: OMPL's default ``DiscreteMotionValidator`` calling the package's
-  state checker, against the package's batched ``MotionValidator``, on colliding and
-  collision-free edges of planner-like length.
+  state checker, against the package's batched discrete ``MotionValidator``
+  (``setup_robot(..., motion="discrete")``), on colliding and collision-free edges of
+  planner-like length. (The certified validator, which answers a different question, is
+  measured in planning by ``bench_certified.py``.)
 
-Usage: ``python benchmarks/bench_validity.py [--data DIR] [--scenes 3] [--states 600] [--edges 300]``
-(DIR defaults to ``<repo>/../shared/data``). Times are CPU time of the process with the checkers
-interleaved; figures are medians over scenes of per-scene ratios.
+Usage: ``python benchmarks/bench_validity.py [--scenes 3] [--states 600] [--edges 300]``.
+Times are CPU time of the process with the checkers interleaved; figures are medians over
+scenes of per-scene ratios.
 """
 
 from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
 
 import fcl
 import numpy as np
@@ -117,7 +118,7 @@ def bench_scene(robot, problem, states, edge_count, rng):
 
     space = space_for(robot)
     si_package = ob.SpaceInformation(space)
-    validity, _motion = setup_robot(si_package, checker)
+    validity, _motion = setup_robot(si_package, checker, motion="discrete")
     si_package.setup()
     si_discrete = ob.SpaceInformation(space)  # OMPL's default DiscreteMotionValidator
     si_discrete.setStateValidityChecker(StateValidityChecker(si_discrete, checker))
@@ -175,16 +176,14 @@ def bench_scene(robot, problem, states, edge_count, rng):
 
 
 def main():
-    repo = Path(__file__).resolve().parents[1]
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data", type=Path, default=repo.parent / "shared" / "data")
     parser.add_argument("--scenes", type=int, default=3, help="table_pick problems to use")
     parser.add_argument("--states", type=int, default=600, help="random states per scene")
     parser.add_argument("--edges", type=int, default=300, help="random edges per scene")
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
-    robot = load_panda_vamp(args.data / "robots" / "panda_vamp")
-    problems = load_mbm(args.data / "mbm" / "panda" / "table_pick.json", robot.joint_names)[: args.scenes]
+    robot = load_panda_vamp()
+    problems = load_mbm("table_pick", robot.joint_names)[: args.scenes]
     rng = np.random.default_rng(args.seed)
     rows = []
     for problem in problems:

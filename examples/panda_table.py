@@ -1,8 +1,10 @@
-"""A Panda reaching around a box on a table, planned with stock RRT-Connect (and BalancedRRTConnect when present).
+"""A Panda reaching around a box on a table, planned with stock RRT-Connect and BalancedRRTConnect.
 
 Uses example-robot-data's Panda (``pip install 'ompl-balance[robots]'``): 8 joints, the
-eighth being the finger opening, held at 0.02 m here. Prints time, path length and the
-collision-checking work of each planner. Run: ``python examples/panda_table.py``.
+eighth being the finger opening, held at 0.02 m here. ``setup_robot`` installs the
+certified motion validator: every edge of the returned path is proved collision-free
+(``certify_path`` re-checks it). Prints time, path length and the collision-checking work
+of each planner. Run: ``python examples/panda_table.py``.
 """
 
 import time
@@ -10,14 +12,16 @@ import time
 import numpy as np
 from ompl import geometric as og
 
-from ompl_balance.collision.robots import load_example_robot_data_panda
-from ompl_balance.core.counting import read_work
-from ompl_balance.validity import CollisionChecker, Environment, setup_robot, space_for
-
-try:
-    from ompl_balance import BalancedRRTConnect
-except ImportError:
-    BalancedRRTConnect = None
+from ompl_balance import (
+    BalancedRRTConnect,
+    CollisionChecker,
+    Environment,
+    certify_path,
+    load_example_robot_data_panda,
+    read_work,
+    setup_robot,
+    space_for,
+)
 
 robot = load_example_robot_data_panda()
 environment = Environment()
@@ -29,10 +33,7 @@ start = np.array([-0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # hand in front, 
 goal = np.array([0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # mirrored, right of the box
 assert checker.check([start, goal]).all(), "start and goal must be collision-free"
 
-planners = [("RRTConnect", og.RRTConnect)]
-if BalancedRRTConnect is not None:
-    planners.append(("BalancedRRTConnect", BalancedRRTConnect))
-for name, make_planner in planners:
+for name, make_planner in [("RRTConnect", og.RRTConnect), ("BalancedRRTConnect", BalancedRRTConnect)]:
     ss = og.SimpleSetup(space_for(robot))
     setup_robot(ss, checker)
     si = ss.getSpaceInformation()
@@ -47,7 +48,9 @@ for name, make_planner in planners:
     elapsed = time.perf_counter() - began
     work = read_work(si) - before
     length = ss.getSolutionPath().length() if solved else float("nan")
+    certified = certify_path(checker, ss.getSolutionPath()).certified if solved else False
     print(
         f"{name:20s} {solved.asString() if hasattr(solved, 'asString') else solved!s:16s} {elapsed:6.2f} s  "
-        f"path length {length:.2f} rad  states checked {work.states_checked}  motions checked {work.motions_checked}"
+        f"path length {length:.2f} rad  certified {certified}  states checked {work.states_checked}  "
+        f"motions checked {work.motions_checked}  distance queries {work.distance_queries}"
     )

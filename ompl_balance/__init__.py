@@ -75,6 +75,8 @@ _LAZY = {
     "load_panda_vamp": "collision.robots",
     "StateValidityChecker": "validity",
     "MotionValidator": "validity",
+    "CertifiedMotionValidator": "validity",
+    "certify_path": "validity",
     "space_for": "validity",
     "setup_robot": "validity",
     "load_mbm": "worlds.mbm",

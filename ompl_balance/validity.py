@@ -1,20 +1,35 @@
-"""OMPL adapters for robots: a state validity checker and a motion validator backed by a
-:class:`~ompl_balance.collision.checker.CollisionChecker`, the joint space, and :func:`setup_robot`.
+"""OMPL adapters for robots: a state validity checker and two motion validators backed by a
+:class:`~ompl_balance.collision.checker.CollisionChecker`, the joint space, :func:`setup_robot`
+and :func:`certify_path`.
+
+Motion validators:
+
+* :class:`CertifiedMotionValidator` (the default of :func:`setup_robot`) proves each
+  straight joint-space edge free of collision for the checker's model, with an optional
+  clearance (:mod:`ompl_balance.collision.certified`);
+* :class:`MotionValidator` checks the states OMPL's ``DiscreteMotionValidator`` checks
+  (``validSegmentCount`` of them), in one batch; what lies between them is not looked at.
 
 The checker and its validators share one work counter (see :mod:`ompl_balance.core.counting`),
-so ``RunStats`` and the benchmark logs count the states and motions a planner made them check.
+so ``RunStats`` and the benchmark logs count the states, motions and distance queries a
+planner made them do.
 """
 
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from .collision.certified import MotionCertifier, PathCertificate, certify_states
 from .collision.checker import CollisionChecker
 from .collision.kinematics import RobotModel
+
+#: The motion validators :func:`setup_robot` installs, by name.
+MOTION_VALIDATORS = ("certified", "discrete")
 
 
 def space_for(robot: RobotModel) -> ob.RealVectorStateSpace:
@@ -62,6 +77,7 @@ class MotionValidator(ob.MotionValidator):
     """
 
     def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker):
+        _check_dimension(si, checker)
         super().__init__(si)
         self.checker = checker
         self._space = si.getStateSpace()
@@ -80,13 +96,20 @@ class MotionValidator(ob.MotionValidator):
         ``s1``, ``t = (j - 1) / nd`` for the first invalid state ``j``, and ``last_valid``
         (if given) is set to the state at ``t``. ``t = 1`` for a valid edge, and whenever
         ``last_valid`` is not given (then the states are visited coarse to fine instead).
+        A state with a non-finite value makes the edge invalid with ``t = 0``.
         """
         self.checker.counter.motions_checked += 1
-        b = np.array(s2[0 : self._dof])
+        values = s2[0 : self._dof]
+        if not math.isfinite(sum(values)):
+            return False, 0.0  # invalid, not an exception through OMPL's C++ caller
+        b = np.array(values)
         if last_valid is None and not self.checker.is_valid(b):
             # s2 alone on the single-state path first: it decides most colliding edges
             return False, 1.0
-        a = np.array(s1[0 : self._dof])
+        values = s1[0 : self._dof]
+        if not math.isfinite(sum(values)):
+            return False, 0.0
+        a = np.array(values)
         nd = self._space.validSegmentCount(s1, s2)
         t = np.arange(1, nd + 1) / nd
         if last_valid is None:
@@ -128,21 +151,118 @@ def coarse_to_fine(nd: int) -> tuple[int, ...]:
     return tuple(order)
 
 
-def setup_robot(ss_or_si, checker: CollisionChecker) -> tuple[StateValidityChecker, MotionValidator]:
-    """Install ``checker`` as state validity checker and batched motion validator.
+class CertifiedMotionValidator(ob.MotionValidator):
+    """OMPL motion validator that proves each edge free of collision, or rejects it.
 
-    ``ss_or_si`` is an ``og.SimpleSetup`` or an ``ob.SpaceInformation`` whose space is
-    a real-vector space of the robot's dimension (e.g. from :func:`space_for`). Call
-    before ``setup()``/``solve()``. Returns the two installed objects.
+    An edge ``s1 -> s2`` is valid when the whole straight line ``s1 + t (s2 - s1)``,
+    ``t in [0, 1]``, in joint space is certified: every collision pair of ``checker``'s
+    model (link collision geometry against the environment's obstacles, and the enabled
+    self-collision pairs) stays more than ``clearance`` metres apart. The proof is
+    conservative advancement: distance lower bounds (bounding spheres, GJK on convex hulls,
+    FCL's exact distance) against a bound on how far the links travel
+    (:class:`~ompl_balance.collision.certified.MotionCertifier`). It never calls an edge
+    with a colliding configuration valid; it may reject one that passes within
+    :data:`~ompl_balance.collision.advancement.DISTANCE_TOLERANCE` (10 micrometres) of the
+    clearance. What is not certified: anything off the straight line (a controller's
+    tracking error), geometry the checker does not model (visual meshes, SRDF-disabled
+    pairs), obstacles that move.
+
+    States with a non-finite value or outside the robot's joint bounds make an edge
+    invalid (OMPL's C++ caller gets ``false``, not an exception). Work is counted in the
+    checker's counter: one motion per edge, the configurations evaluated as states, and
+    the distance queries (GJK bounds and FCL distances).
     """
-    si = ss_or_si.getSpaceInformation() if isinstance(ss_or_si, og.SimpleSetup) else ss_or_si
+
+    def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker, clearance: float = 0.0):
+        _check_dimension(si, checker)
+        super().__init__(si)
+        self.checker = checker
+        self.certifier = MotionCertifier(checker, clearance)
+        self._dof = checker.robot.dof
+
+    @property
+    def clearance(self) -> float:
+        """Metres every pair keeps clear of contact along a valid edge."""
+        return self.certifier.clearance
+
+    def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
+        return self.certifier.check(np.array(s1[0 : self._dof]), np.array(s2[0 : self._dof]))[0]
+
+    def check_motion_last_valid(
+        self, s1: ob.State, s2: ob.State, last_valid: ob.State | None = None
+    ) -> tuple[bool, float]:
+        """Validity of the edge and the fraction ``t`` of it certified from ``s1``.
+
+        As OMPL's ``checkMotion(s1, s2, lastValid)`` overload (which the Python binding
+        does not expose): ``[0, t]`` is certified, ``last_valid`` (if given) is set to the
+        state at ``t``, and ``t = 1`` for a valid edge. Without ``last_valid``, a rejected
+        edge reports ``t = 0`` (nothing is refined beyond the first failure).
+        """
+        a, b = np.array(s1[0 : self._dof]), np.array(s2[0 : self._dof])
+        valid, fraction = self.certifier.check(a, b, last_valid=last_valid is not None)
+        if last_valid is not None and not valid:
+            for i, value in enumerate(a + fraction * (b - a) if np.isfinite(a).all() else a):
+                last_valid[i] = float(value)
+        return valid, fraction
+
+    def counters(self) -> dict[str, int]:
+        return self.checker.counters()
+
+    def reset_counters(self) -> None:
+        self.checker.reset_counters()
+
+
+def _check_dimension(si: ob.SpaceInformation, checker: CollisionChecker) -> None:
     dimension = si.getStateDimension()
     if dimension != checker.robot.dof:
         raise ValueError(
             f"space has dimension {dimension}, robot {checker.robot.name!r} has {checker.robot.dof} joints"
         )
+
+
+def setup_robot(
+    ss_or_si: og.SimpleSetup | ob.SpaceInformation,
+    checker: CollisionChecker,
+    motion: str = "certified",
+    clearance: float = 0.0,
+) -> tuple[StateValidityChecker, CertifiedMotionValidator | MotionValidator]:
+    """Install ``checker`` as state validity checker, and a motion validator.
+
+    ``ss_or_si`` is an ``og.SimpleSetup`` or an ``ob.SpaceInformation`` whose space is
+    a real-vector space of the robot's dimension (e.g. from :func:`space_for`).
+    ``motion`` is ``"certified"`` (:class:`CertifiedMotionValidator`, keeping
+    ``clearance`` metres) or ``"discrete"`` (:class:`MotionValidator`, OMPL's discrete
+    states only). Call before ``setup()``/``solve()``. Returns the two installed objects.
+    """
+    if motion not in MOTION_VALIDATORS:
+        raise ValueError(f"motion must be one of {', '.join(map(repr, MOTION_VALIDATORS))}, got {motion!r}")
+    if motion == "discrete" and clearance != 0.0:
+        raise ValueError(f"clearance={clearance} needs motion='certified' (the discrete validator keeps none)")
+    si = ss_or_si.getSpaceInformation() if isinstance(ss_or_si, og.SimpleSetup) else ss_or_si
+    _check_dimension(si, checker)
     validity = StateValidityChecker(si, checker)
-    motion = MotionValidator(si, checker)
+    validator: CertifiedMotionValidator | MotionValidator
+    if motion == "certified":
+        validator = CertifiedMotionValidator(si, checker, clearance)
+    else:
+        validator = MotionValidator(si, checker)
     si.setStateValidityChecker(validity)
-    si.setMotionValidator(motion)
-    return validity, motion
+    si.setMotionValidator(validator)
+    return validity, validator
+
+
+def certify_path(
+    checker: CollisionChecker, states: np.ndarray | og.PathGeometric, clearance: float = 0.0
+) -> PathCertificate:
+    """Certify a path's straight joint-space segments for ``checker``'s model.
+
+    ``states`` is an ``(n, dof)`` array or an ``og.PathGeometric`` (a stock planner's or a
+    smoother's output). Returns a :class:`~ompl_balance.collision.certified.PathCertificate`:
+    whether every segment is certified with ``clearance`` metres to spare, the first
+    segment that is not (and how much of it is), and the smallest exact distance at the
+    path's states. Counts its work in the checker's counter.
+    """
+    if isinstance(states, og.PathGeometric):
+        dof = checker.robot.dof
+        states = np.array([states.getState(i)[0:dof] for i in range(states.getStateCount())]).reshape(-1, dof)
+    return certify_states(checker, states, clearance)

@@ -119,3 +119,63 @@ def test_bad_configurations():
         robot.fk([[0.0, np.nan, 0.1]])
     with pytest.raises(ValueError, match=r"\(n, 3\)"):
         robot.fk(np.zeros((2, 4)))
+
+
+LINKS_AB = '<link name="a"/><link name="b"/>'
+REVOLUTE = '<parent link="a"/><child link="b"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        (f'{LINKS_AB}\n<joint type="revolute">{REVOLUTE}</joint>', r"line 2: <joint> has no 'name' attribute"),
+        (
+            '<link name="a"/>\n<joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>',
+            r"line 2: <joint name='j'> names child link 'b', not a <link> of the file",
+        ),
+        (
+            f'{LINKS_AB}\n<joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>',
+            r"line 2: joint 'j' \(revolute\) has no <limit lower=\.\.\. upper=\.\.\.>",
+        ),
+        (
+            f'{LINKS_AB}\n<joint name="j" type="prismatic"><parent link="a"/><child link="b"/>\n<limit upper="1"/></joint>',
+            r"line 3: joint 'j': <limit> has no 'lower' attribute",
+        ),
+        (
+            f'{LINKS_AB}\n<joint name="j" type="revolute"><child link="b"/></joint>',
+            r"line 2: <joint name='j'> has no <parent link=\.\.\.>",
+        ),
+        (
+            f'{LINKS_AB}\n<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+            '<limit lower="low" upper="1"/></joint>',
+            r"line 2: joint 'j': <limit lower='low'> must be a number",
+        ),
+        ('<link name="a"/>\n<link/>', r"line 2: <link> has no 'name' attribute"),
+        (
+            '<link name="a">\n<collision><geometry><cylinder radius="0.1"/></geometry></collision></link>',
+            r"line 2: link 'a': <cylinder> has no 'length' attribute",
+        ),
+        (
+            '<link name="a"><collision><geometry>\n<mesh/></geometry></collision></link>',
+            r"line 2: link 'a': <mesh> has no 'filename' attribute",
+        ),
+        (
+            f'{LINKS_AB}<link name="c"/>\n<joint name="j" type="fixed"><parent link="a"/><child link="c"/></joint>'
+            '\n<joint name="k" type="fixed"><parent link="b"/><child link="c"/></joint>',
+            r"line 3: link 'c' is the child of two joints \('j' and 'k'\)",
+        ),
+        (
+            f'{LINKS_AB}\n<joint name="j" type="floating"><parent link="a"/><child link="b"/></joint>',
+            r"line 2: <joint name='j'> has type 'floating'; supported: fixed, revolute, continuous, prismatic",
+        ),
+        (
+            f'{LINKS_AB}\n<joint name="j" type="revolute">{REVOLUTE}<mimic joint="elbow"/></joint>',
+            r"line 2: <joint name='j'> mimics joint 'elbow', not a <joint> of the file",
+        ),
+    ],
+)
+def test_malformed_urdf_says_what_and_where(tmp_path, body, message):
+    path = tmp_path / "broken.urdf"
+    path.write_text(f'<robot name="broken">{body}</robot>\n')
+    with pytest.raises(ValueError, match=rf"URDF .*broken\.urdf, {message}"):
+        RobotModel.from_urdf(path)

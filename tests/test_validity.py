@@ -159,7 +159,7 @@ def check_motion_validator(robot, environment, edges_count, seed):
     rng = np.random.default_rng(seed)
     checker = CollisionChecker(robot, environment)
     space, si = make_si(robot, checker)
-    _validity, motion = setup_robot(si, checker)
+    _validity, motion = setup_robot(si, checker, motion="discrete")
     si.setup()
     _discrete_space, discrete_si = make_si(robot, checker)
     discrete_si.setStateValidityChecker(StateValidityChecker(discrete_si, CollisionChecker(robot, environment)))
@@ -248,7 +248,11 @@ def test_bad_input():
         environment.add_box("tilted", [1, 1, 1], orientation_xyzw=[0, 0, 1, 1])
     with pytest.raises(ValueError, match="positive"):
         environment.add_sphere("flat", 0.0)
-    assert isinstance(MotionValidator(si, checker), ob.MotionValidator)
+    discrete = MotionValidator(si, checker)
+    assert isinstance(discrete, ob.MotionValidator)
+    good = si.allocState()
+    good[0], good[1], good[2] = 0.0, 0.0, 0.0
+    assert discrete.check_motion_last_valid(good, state) == (False, 0.0)  # NaN: invalid, no exception
 
 
 def test_warm_up_compiles_the_kernels_real_checkers_use():

@@ -18,6 +18,7 @@ import os
 import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -64,7 +65,8 @@ def cached_arrays(
     try:
         directory.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=directory, suffix=".npz", delete=False) as temporary:
-            np.savez(temporary, **arrays)
+            named: dict[str, Any] = dict(arrays)
+            np.savez(temporary, **named)
         os.replace(temporary.name, path)  # atomic: concurrent runs never read half a file
     except OSError:  # read-only home, full disk: work without the cache
         if temporary is not None:

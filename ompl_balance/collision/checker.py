@@ -23,16 +23,21 @@ The checker counts what it checks in its :class:`WorkCounter`, which the OMPL ad
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import Path
 
 import fcl
-import numba
 import numpy as np
 import trimesh
+from numpy.typing import ArrayLike
 
 from .geometry import Shape, fcl_transform, pose_matrix
 from .kinematics import RobotModel
-from .screening import build_volumes, screen
+from .screening import build_volumes, entry_point, screen
+
+#: The identity rotation as a quaternion, scalar last.
+XYZW = (0.0, 0.0, 0.0, 1.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,10 +56,12 @@ class Environment:
     ``orientation_xyzw`` (scalar last), rotating shape axes into the world.
     """
 
-    def __init__(self):
+    def __init__(self) -> None:
         self.obstacles: list[Obstacle] = []
 
-    def add(self, name: str, shape: Shape, position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+    def add(
+        self, name: str, shape: Shape, position: ArrayLike = (0.0, 0.0, 0.0), orientation_xyzw: Iterable[float] = XYZW
+    ) -> None:
         if any(o.name == name for o in self.obstacles):
             raise ValueError(f"environment already has an obstacle named {name!r}")
         try:
@@ -63,42 +70,76 @@ class Environment:
             raise ValueError(f"obstacle {name!r}: {error}") from error
         self.obstacles.append(Obstacle(name, shape, pose))
 
-    def add_box(self, name: str, half_extents, position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+    def add_box(
+        self,
+        name: str,
+        half_extents: Iterable[float],
+        position: ArrayLike = (0.0, 0.0, 0.0),
+        orientation_xyzw: Iterable[float] = XYZW,
+    ) -> None:
         """A box with ``half_extents`` (hx, hy, hz), half the edge lengths."""
         self.add(name, Shape.box(half_extents), position, orientation_xyzw)
 
-    def add_sphere(self, name: str, radius: float, position=(0.0, 0.0, 0.0)) -> None:
+    def add_sphere(self, name: str, radius: float, position: ArrayLike = (0.0, 0.0, 0.0)) -> None:
         self.add(name, Shape.sphere(radius), position)
 
     def add_cylinder(
-        self, name: str, radius: float, length: float, position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)
+        self,
+        name: str,
+        radius: float,
+        length: float,
+        position: ArrayLike = (0.0, 0.0, 0.0),
+        orientation_xyzw: Iterable[float] = XYZW,
     ) -> None:
         """A cylinder along its local z, ``length`` the full height, centred on ``position``."""
         self.add(name, Shape.cylinder(radius, length), position, orientation_xyzw)
 
-    def add_mesh(self, name: str, mesh, position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+    def add_mesh(
+        self,
+        name: str,
+        mesh: trimesh.Trimesh | str | Path,
+        position: ArrayLike = (0.0, 0.0, 0.0),
+        orientation_xyzw: Iterable[float] = XYZW,
+    ) -> None:
         """A triangle mesh: a ``trimesh.Trimesh`` or a file trimesh can read."""
-        if not isinstance(mesh, trimesh.Trimesh):
+        if isinstance(mesh, trimesh.Trimesh):
+            triangles = mesh
+        else:
             try:
-                mesh = trimesh.load(str(mesh), force="mesh")
+                loaded = trimesh.load(str(mesh), force="mesh")
             except Exception as error:
                 raise ValueError(f"obstacle {name!r}: cannot read mesh {mesh}: {error}") from error
-        self.add(name, Shape.from_mesh(mesh), position, orientation_xyzw)
+            if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+                raise ValueError(f"obstacle {name!r}: mesh file {mesh} holds no triangles")
+            triangles = loaded
+        self.add(name, Shape.from_mesh(triangles), position, orientation_xyzw)
 
 
 class WorkCounter:
-    """States and motions checked; one instance is shared by a checker and its motion validator."""
+    """Work done for a planner; one instance is shared by a checker and its motion validator.
 
-    def __init__(self):
+    ``states_checked``: configurations evaluated (a state check, a state of a discrete
+    edge, a configuration a certified edge was bounded at); ``motions_checked``: edges;
+    ``distance_queries``: distance bounds computed by GJK on convex hulls and FCL exact
+    distances (certified motions only).
+    """
+
+    def __init__(self) -> None:
         self.states_checked = 0
         self.motions_checked = 0
+        self.distance_queries = 0
 
     def counters(self) -> dict[str, int]:
-        return {"states_checked": self.states_checked, "motions_checked": self.motions_checked}
+        return {
+            "states_checked": self.states_checked,
+            "motions_checked": self.motions_checked,
+            "distance_queries": self.distance_queries,
+        }
 
     def reset(self) -> None:
         self.states_checked = 0
         self.motions_checked = 0
+        self.distance_queries = 0
 
 
 class CollisionChecker:
@@ -147,12 +188,11 @@ class CollisionChecker:
         # isValid) reuses its output arrays.
         self._one = self._screen_outputs(1)
         arguments = (np.zeros((1, robot.dof)), robot.chain, self._volumes, *self._one)
-        screen(*arguments)  # compile or load the kernel now, not in a solve
-        self._kernel = screen.overloads[tuple(numba.typeof(a) for a in arguments)].entry_point
+        self._kernel = entry_point(screen, arguments)  # compiled or loaded now, not in a solve
 
     # ------------------------------------------------------------------ public API
 
-    def check(self, q) -> np.ndarray:
+    def check(self, q: ArrayLike) -> np.ndarray:
         """Validity (collision-free) of each configuration: ``q`` (n, dof) or (dof,) -> bool (n,)."""
         q = self.robot.as_array(q)
         self.counter.states_checked += len(q)
@@ -166,7 +206,7 @@ class CollisionChecker:
             valid[i] = self._free_exact(poses[i], obstacle_hits[i], self_hits[i])
         return valid
 
-    def is_valid(self, q) -> bool:
+    def is_valid(self, q: ArrayLike) -> bool:
         """Validity of one configuration ``q`` (dof,)."""
         q = self.robot.as_array(q)
         if len(q) != 1:
@@ -177,7 +217,7 @@ class CollisionChecker:
         poses, obstacle_hits, self_hits = self._one
         return not self._screen(q, self._one)[0] or self._free_exact(poses[0], obstacle_hits[0], self_hits[0])
 
-    def first_collision(self, q, order=None, first_chunk: int = 1) -> int:
+    def first_collision(self, q: ArrayLike, order: ArrayLike | None = None, first_chunk: int = 1) -> int:
         """Index of the first configuration in collision, visiting ``q`` (n, dof) in ``order``, or -1.
 
         The first ``first_chunk`` rows of ``order`` (default: row order) go through
@@ -200,7 +240,7 @@ class CollisionChecker:
                 poses, obstacle_hits, self_hits = outputs
                 hit = next(
                     (
-                        k
+                        int(k)
                         for k in np.flatnonzero(maybe)
                         if not self._free_exact(poses[k], obstacle_hits[k], self_hits[k])
                     ),
@@ -227,7 +267,7 @@ class CollisionChecker:
             np.empty((n, len(self._pairs)), dtype=bool),
         )
 
-    def _screen(self, q: np.ndarray, outputs) -> np.ndarray:
+    def _screen(self, q: np.ndarray, outputs: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
         """Screen ``q`` (n, dof) into ``outputs`` (from :meth:`_screen_outputs`); True where FCL must decide."""
         return self._kernel(np.ascontiguousarray(q), self.robot.chain, self._volumes, *outputs)
 
@@ -248,9 +288,9 @@ class CollisionChecker:
         ``body_poses`` (bodies, 4, 4), ``obstacle_hits`` (obstacles, geometries) and
         ``self_hits`` (pairs) as filled by :meth:`_screen`.
         """
-        placed = set()
+        placed: set[int] = set()
 
-        def place(geometry):
+        def place(geometry: int) -> None:
             if geometry not in placed:
                 self._place(body_poses, geometry)
                 placed.add(geometry)

@@ -18,13 +18,19 @@ suffices; for primitives (solids in FCL) the spheres cover the whole solid.
 from __future__ import annotations
 
 import weakref
+from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import fcl
 import numpy as np
+import scipy.spatial
 import trimesh
+from numpy.typing import ArrayLike
 
 from .cache import cached_arrays
+
+Trimesh = trimesh.Trimesh
 
 SHAPE_KINDS = ("box", "sphere", "cylinder", "mesh")
 
@@ -45,7 +51,7 @@ class Shape:
     dims: tuple[float, ...] = ()
     mesh: trimesh.Trimesh | None = field(default=None, repr=False)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         expected = {"box": 3, "sphere": 1, "cylinder": 2, "mesh": 0}
         if self.kind not in expected:
             raise ValueError(f"unknown shape kind {self.kind!r}; expected one of {SHAPE_KINDS}")
@@ -59,7 +65,7 @@ class Shape:
             raise ValueError("mesh shape has no triangles")
 
     @staticmethod
-    def box(half_extents) -> Shape:
+    def box(half_extents: Iterable[float]) -> Shape:
         return Shape("box", tuple(float(h) for h in half_extents))
 
     @staticmethod
@@ -82,13 +88,14 @@ class Shape:
             return fcl.Sphere(self.dims[0])
         if self.kind == "cylinder":
             return fcl.Cylinder(*self.dims)
+        mesh = self._triangles()
         model = fcl.BVHModel()
-        model.beginModel(len(self.mesh.vertices), len(self.mesh.faces))
-        model.addSubModel(np.asarray(self.mesh.vertices, dtype=float), np.asarray(self.mesh.faces, dtype=np.int32))
+        model.beginModel(len(mesh.vertices), len(mesh.faces))
+        model.addSubModel(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int32))
         model.endModel()
         return model
 
-    def trimesh(self) -> trimesh.Trimesh:
+    def trimesh(self) -> Trimesh:
         """This shape as a triangle mesh (primitives tessellated; cylinders with 64 sides)."""
         if self.kind == "box":
             return trimesh.creation.box(extents=2.0 * np.asarray(self.dims))
@@ -96,7 +103,40 @@ class Shape:
             return trimesh.creation.icosphere(subdivisions=3, radius=self.dims[0])
         if self.kind == "cylinder":
             return trimesh.creation.cylinder(radius=self.dims[0], height=self.dims[1], sections=64)
+        return self._triangles()
+
+    def _triangles(self) -> Trimesh:
+        """The mesh of a mesh shape."""
+        if self.mesh is None:
+            raise ValueError(f"a {self.kind} shape has no triangle mesh; use trimesh() for a tessellation")
         return self.mesh
+
+    def hull_vertices(self) -> np.ndarray | None:
+        """Vertices (m, 3) of a mesh's convex hull (``None`` for primitives); computed once.
+
+        Only the hull matters for support functions, so this is what the distance bounds
+        use. Flat or degenerate meshes keep all their (distinct) vertices.
+        """
+        if self.mesh is None:
+            return None
+        if self not in _HULL_OF:
+            vertices, solid = _convex_hull(self.mesh)
+            vertices.setflags(write=False)
+            _HULL_OF[self] = vertices, solid
+        return _HULL_OF[self][0]
+
+    @property
+    def convex(self) -> bool:
+        """Whether the shape is (nearly) its convex hull, so that FCL's distance to it is the hull's.
+
+        Primitives are convex; a mesh counts as convex when it is closed and its volume is
+        within 0.1 % of its hull's (its triangles are then the hull's surface but for small
+        dents: the hull is what is treated as in contact).
+        """
+        if self.mesh is None:
+            return True
+        self.hull_vertices()
+        return bool(_HULL_OF[self][1])
 
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         """An oriented box containing the shape: ``(pose (4, 4) in the shape frame, half extents (3,))``."""
@@ -143,11 +183,12 @@ class Shape:
             return np.zeros((1, 3)), np.array([self.dims[0]])
         if self.kind == "mesh":
             # cut long triangles first (the pieces cover the same surface) so spheres can shrink
-            whole = _TrianglePiece(np.asarray(self.mesh.triangles, dtype=float))
+            mesh = self._triangles()
+            whole = _TrianglePiece(np.asarray(mesh.triangles, dtype=float))
             vertices, faces = trimesh.remesh.subdivide_to_size(
-                self.mesh.vertices, self.mesh.faces, max_edge=whole.radius / count, max_iter=20
+                mesh.vertices, mesh.faces, max_edge=whole.radius / count, max_iter=20
             )
-            pieces = [_TrianglePiece(np.asarray(vertices, dtype=float)[faces])]
+            pieces: list[_Piece] = [_TrianglePiece(np.asarray(vertices, dtype=float)[faces])]
         else:
             _pose, half = self.bounding_box()  # identity pose for box and cylinder
             pieces = [_BoxPiece(np.zeros(3), np.asarray(half, dtype=float))]
@@ -160,6 +201,43 @@ class Shape:
         return np.array([p.centre for p in pieces]), np.array([p.radius for p in pieces])
 
 
+_HULL_OF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # Shape -> (hull vertices, convex)
+
+
+def _convex_hull(mesh: trimesh.Trimesh) -> tuple[np.ndarray, bool]:
+    """The vertices of ``mesh``'s convex hull and whether the mesh is closed and fills it.
+
+    The hull (Qhull) is checked to hold every vertex of the mesh, to 1e-9 m; a hull that
+    fails the check or has no volume is replaced by all the mesh's vertices (the same
+    convex set, only slower to search).
+    """
+    points = np.unique(np.asarray(mesh.vertices, dtype=float), axis=0)
+    try:
+        hull = scipy.spatial.ConvexHull(points)
+    except scipy.spatial.QhullError:  # flat or degenerate
+        return points, False
+    outside = max(
+        float((chunk @ hull.equations[:, :3].T + hull.equations[:, 3]).max())
+        for chunk in np.array_split(points, max(1, len(points) // 512))
+    )
+    if not (hull.volume > 0.0 and outside <= 1e-9):
+        return points, False
+    merged = mesh.copy()
+    merged.merge_vertices()
+    # closed and of the hull's volume (to 0.1 %): the triangles are the hull's surface but for dents
+    solid = bool(merged.is_watertight and abs(abs(merged.volume) - hull.volume) <= 1e-3 * hull.volume)
+    return points[hull.vertices], solid
+
+
+class _Piece(Protocol):
+    """A piece of a shape and the sphere about ``centre`` (3,) of ``radius`` that holds it."""
+
+    centre: np.ndarray
+    radius: float
+
+    def split(self) -> list[_Piece] | None: ...
+
+
 class _BoxPiece:
     """An axis-aligned box ``centre`` (3,) +- ``half`` (3,) and its circumscribed sphere."""
 
@@ -167,7 +245,7 @@ class _BoxPiece:
         self.centre, self.half = centre, half
         self.radius = float(np.linalg.norm(half))
 
-    def split(self) -> list[_BoxPiece]:
+    def split(self) -> list[_Piece]:
         axis = int(np.argmax(self.half))
         half = self.half.copy()
         half[axis] *= 0.5
@@ -185,7 +263,7 @@ class _TrianglePiece:
         self.centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
         self.radius = float(np.sqrt(((points - self.centre) ** 2).sum(axis=1).max()))
 
-    def split(self) -> list[_TrianglePiece] | None:
+    def split(self) -> list[_Piece] | None:
         if len(self.triangles) < 2:
             return None
         centroids = self.triangles.mean(axis=1)
@@ -195,9 +273,12 @@ class _TrianglePiece:
         return [_TrianglePiece(self.triangles[order[:middle]]), _TrianglePiece(self.triangles[order[middle:]])]
 
 
-def pose_matrix(position=(0.0, 0.0, 0.0), orientation_xyzw=(0.0, 0.0, 0.0, 1.0)) -> np.ndarray:
+def pose_matrix(
+    position: ArrayLike = (0.0, 0.0, 0.0), orientation_xyzw: Iterable[float] = (0.0, 0.0, 0.0, 1.0)
+) -> np.ndarray:
     """Homogeneous transform (4, 4) from a position (m) and a unit quaternion, scalar last."""
-    x, y, z, w = (float(v) for v in orientation_xyzw)
+    orientation_xyzw = [float(v) for v in orientation_xyzw]
+    x, y, z, w = orientation_xyzw
     norm = np.sqrt(x * x + y * y + z * z + w * w)
     if not np.isfinite(norm) or abs(norm - 1.0) > 1e-3:
         raise ValueError(f"orientation_xyzw must be a unit quaternion [x, y, z, w], got {list(orientation_xyzw)}")

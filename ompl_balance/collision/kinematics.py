@@ -17,18 +17,21 @@ joints get the bounds ``[-pi, pi]`` (a real-vector space does not wrap around).
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from itertools import combinations
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 from urllib.parse import unquote, urlparse
 
 import numpy as np
 import trimesh
 import yourdfpy
 from numba import njit
+from numpy.typing import ArrayLike
 
 from .geometry import Shape
+from .urdf import check_urdf
 
 MOVING_JOINTS = ("revolute", "continuous", "prismatic")
 
@@ -79,7 +82,7 @@ class Chain(NamedTuple):
 
 
 @njit(cache=True)
-def chain_poses(q, chain, poses):  # pragma: no cover (compiled)
+def chain_poses(q: np.ndarray, chain: Chain, poses: np.ndarray) -> None:  # pragma: no cover (compiled)
     """World poses of the bodies of one configuration ``q`` (dof,) into ``poses`` (bodies, 4, 4)."""
     poses[0] = 0.0
     for axis in range(4):
@@ -108,7 +111,7 @@ def chain_poses(q, chain, poses):  # pragma: no cover (compiled)
 
 
 @njit(cache=True)
-def _chain_poses_batch(q, chain, poses):  # pragma: no cover (compiled)
+def _chain_poses_batch(q: np.ndarray, chain: Chain, poses: np.ndarray) -> None:  # pragma: no cover (compiled)
     for i in range(len(q)):
         chain_poses(q[i], chain, poses[i])
 
@@ -123,7 +126,13 @@ class RobotModel:
     ``self_collision_pairs`` the geometry index pairs checked for self-collision.
     """
 
-    def __init__(self, urdf: yourdfpy.URDF, geometries_of, disabled_links: set[frozenset[str]], name: str):
+    def __init__(
+        self,
+        urdf: yourdfpy.URDF,
+        geometries_of: Callable[[Any], Iterable[tuple[np.ndarray, Shape, str | None]]],
+        disabled_links: set[frozenset[str]],
+        name: str,
+    ):
         robot = urdf.robot
         joints_by_child = {j.child: j for j in robot.joints}
         children: dict[str, list] = {}
@@ -184,7 +193,7 @@ class RobotModel:
                 body_parent.append(body)
                 stack.append((j.child, len(self._joints), np.eye(4)))
         joints = self._joints
-        offset = np.array([j.offset for j in joints]).reshape(-1, 4, 4)
+        offsets = np.array([j.offset for j in joints]).reshape(-1, 4, 4)
         axis = np.array([j.axis for j in joints]).reshape(-1, 3)
         # Each joint's transform parent body -> child body is offset @ motion(value). With K the
         # cross-product matrix of the axis, a revolute motion rotates by I + sin(v) K + (1 - cos(v)) K^2
@@ -194,7 +203,7 @@ class RobotModel:
         x, y, z = axis.T
         zero = np.zeros_like(x)
         cross = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1).reshape(-1, 3, 3)
-        rotation = offset[:, :3, :3]
+        rotation = offsets[:, :3, :3]
         self.chain = Chain(
             source=np.array([j.source for j in joints], dtype=np.int64),
             multiplier=np.array([j.multiplier for j in joints], dtype=float),
@@ -203,7 +212,7 @@ class RobotModel:
             rotation_fixed=np.ascontiguousarray(rotation + revolute * (rotation @ cross @ cross)),
             rotation_sin=np.ascontiguousarray(revolute * (rotation @ cross)),
             rotation_cos=np.ascontiguousarray(revolute * (rotation @ cross @ cross)),
-            translation=np.ascontiguousarray(offset[:, :3, 3]),
+            translation=np.ascontiguousarray(offsets[:, :3, 3]),
             slide=np.ascontiguousarray((1.0 - revolute[:, :, 0]) * (rotation @ axis[:, :, None])[:, :, 0]),
             axis=np.ascontiguousarray(axis),
         )
@@ -239,7 +248,9 @@ class RobotModel:
         return len(self._joints) + 1
 
     @staticmethod
-    def from_urdf(urdf_path, srdf_path=None, package_map: dict[str, str] | None = None) -> RobotModel:
+    def from_urdf(
+        urdf_path: str | Path, srdf_path: str | Path | None = None, package_map: dict[str, str] | None = None
+    ) -> RobotModel:
         """Load a robot from a URDF file and, optionally, its MoveIt SRDF.
 
         ``package_map`` maps ROS package names to directories for ``package://NAME/...``
@@ -248,8 +259,7 @@ class RobotModel:
         package. Only ``<collision>`` elements are read; ``<visual>`` is ignored.
         """
         urdf_path = Path(urdf_path)
-        if not urdf_path.is_file():
-            raise FileNotFoundError(f"URDF file not found: {urdf_path}")
+        check_urdf(urdf_path)  # what and where, before yourdfpy's terser messages
         try:
             urdf = yourdfpy.URDF.load(
                 str(urdf_path),
@@ -266,7 +276,7 @@ class RobotModel:
         disabled = _srdf_disabled_pairs(Path(srdf_path)) if srdf_path is not None else set()
         return RobotModel(urdf, lambda link: _link_shapes(link, resolve), disabled, urdf.robot.name)
 
-    def as_array(self, q) -> np.ndarray:
+    def as_array(self, q: ArrayLike) -> np.ndarray:
         """``q`` as a float array (n, dof); raises ``ValueError`` for a wrong shape or non-finite values."""
         q = np.asarray(q, dtype=float)
         q2 = q.reshape(1, -1) if q.ndim == 1 else q
@@ -281,14 +291,14 @@ class RobotModel:
             )
         return q2
 
-    def body_poses(self, q) -> np.ndarray:
+    def body_poses(self, q: ArrayLike) -> np.ndarray:
         """World poses of the bodies, (n, bodies, 4, 4), for configurations ``q`` (n, dof)."""
         q = self.as_array(q)
         poses = np.empty((len(q), self.body_count, 4, 4))
         _chain_poses_batch(q, self.chain, poses)
         return poses
 
-    def fk(self, q) -> np.ndarray:
+    def fk(self, q: ArrayLike) -> np.ndarray:
         """World poses of all links, (n, links, 4, 4), in :attr:`link_names` order.
 
         ``q`` is (n, dof) or (dof,) in :attr:`joint_names` order; the root link is the world frame.
@@ -296,7 +306,7 @@ class RobotModel:
         return self.body_poses(q)[:, self._link_body] @ self._link_offset
 
 
-def _limits(joint) -> tuple[float, float]:
+def _limits(joint: yourdfpy.Joint) -> tuple[float, float]:
     if joint.type == "continuous":
         return -np.pi, np.pi
     limit = joint.limit
@@ -338,7 +348,7 @@ class _MeshResolver:
         )
 
 
-def _link_shapes(link, resolve: _MeshResolver):
+def _link_shapes(link: yourdfpy.Link, resolve: _MeshResolver) -> Iterator[tuple[np.ndarray, Shape, str | None]]:
     """``(origin (4, 4), Shape, source file or None)`` for each ``<collision>`` of a yourdfpy link."""
     for collision in link.collisions:
         origin = np.eye(4) if collision.origin is None else np.asarray(collision.origin, dtype=float)

@@ -18,7 +18,7 @@ def example_robot_data_dir() -> Path:
         distribution = metadata.distribution("example-robot-data")
     except metadata.PackageNotFoundError as error:
         raise ImportError("example-robot-data is not installed: pip install 'ompl-balance[robots]'") from error
-    share = Path(distribution.locate_file("cmeel.prefix/share/example-robot-data"))
+    share = Path(str(distribution.locate_file("cmeel.prefix/share/example-robot-data")))
     if not share.is_dir():
         raise FileNotFoundError(f"example-robot-data is installed but {share} is missing")
     return share

@@ -30,15 +30,20 @@ cost tens of microseconds of per-call overhead at these array sizes.
 from __future__ import annotations
 
 import weakref
-from typing import NamedTuple
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import fcl
+import numba
 import numpy as np
 from numba import njit
 
 from .cache import cached_arrays
 from .geometry import fcl_transform
-from .kinematics import Chain, _chain_poses_batch, chain_poses
+from .kinematics import Chain, RobotModel, _chain_poses_batch, chain_poses
+
+if TYPE_CHECKING:  # (the checker imports this module)
+    from .checker import Obstacle
 
 #: Slack (m) added to every bounding-volume test so that rounding never clears a contact.
 SLACK = 1e-6
@@ -79,7 +84,7 @@ class Volumes(NamedTuple):
     table_free: np.ndarray
 
 
-def build_volumes(robot, obstacles, spheres_per_geometry: int) -> Volumes:
+def build_volumes(robot: RobotModel, obstacles: Sequence[Obstacle], spheres_per_geometry: int) -> Volumes:
     """:class:`Volumes` for ``robot`` (a :class:`~ompl_balance.collision.kinematics.RobotModel`)
     among ``obstacles`` (:class:`~ompl_balance.validity.Obstacle` list)."""
     geometries = robot.geometries
@@ -113,7 +118,7 @@ def build_volumes(robot, obstacles, spheres_per_geometry: int) -> Volumes:
 TABLE_COARSE_CELLS, TABLE_LEVELS = 8, 4
 
 
-def two_joint_path(chain, body_a: int, body_b: int) -> tuple[int, int] | None:
+def two_joint_path(chain: Chain, body_a: int, body_b: int) -> tuple[int, int] | None:
     """The two revolute joints ``(upper, lower)`` between ``body_a`` and its descendant
     ``body_b``, or ``None`` when ``body_b`` is not a descendant or other joints lie between."""
     path, body = [], body_b
@@ -125,7 +130,7 @@ def two_joint_path(chain, body_a: int, body_b: int) -> tuple[int, int] | None:
     return path[1], path[0]
 
 
-def free_table(robot, a: int, b: int, upper: int, lower: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def free_table(robot: RobotModel, a: int, b: int, upper: int, lower: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Certified-free cells of geometry ``b`` against ``a`` over joints ``upper`` and ``lower``.
 
     ``b`` hangs below ``lower``, which hangs below ``upper``, which hangs below ``a``'s
@@ -144,7 +149,8 @@ def free_table(robot, a: int, b: int, upper: int, lower: int) -> tuple[np.ndarra
     """
     chain = robot.chain
     geometry_a, geometry_b = robot.geometries[a], robot.geometries[b]
-    if geometry_b.shape.kind == "mesh":
+    radii: float | np.ndarray
+    if geometry_b.shape.mesh is not None:
         centres, radii = np.asarray(geometry_b.shape.mesh.vertices, dtype=float), 0.0
     else:
         centres, radii = geometry_b.shape.bounding_spheres(8)
@@ -199,7 +205,7 @@ def free_table(robot, a: int, b: int, upper: int, lower: int) -> tuple[np.ndarra
 _TABLES_OF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # robot -> _free_tables(robot)
 
 
-def _free_tables(robot) -> dict[str, np.ndarray]:
+def _free_tables(robot: RobotModel) -> dict[str, np.ndarray]:
     """The ``Volumes`` fields of the certified-free tables of ``robot``'s self-collision pairs.
 
     A fraction of a second per table: computed once per robot and process, and kept in
@@ -222,8 +228,14 @@ def _free_tables(robot) -> dict[str, np.ndarray]:
     return _TABLES_OF[robot]
 
 
-def _compute_free_tables(robot) -> dict[str, np.ndarray]:
-    pair_table, joints, lows, cells, counts, starts, grids = [], [], [], [], [], [], []
+def _compute_free_tables(robot: RobotModel) -> dict[str, np.ndarray]:
+    pair_table: list[int] = []
+    joints: list[tuple[int, int]] = []
+    lows: list[np.ndarray] = []
+    cells: list[np.ndarray] = []
+    counts: list[tuple[int, ...]] = []
+    starts: list[int] = []
+    grids: list[np.ndarray] = []
     start = 0
     for a, b in robot.self_collision_pairs:
         body_a, body_b = robot.geometries[a].body, robot.geometries[b].body
@@ -254,13 +266,13 @@ def _compute_free_tables(robot) -> dict[str, np.ndarray]:
 
 
 @njit(cache=True)
-def _to_world(pose, centre, out):  # pragma: no cover (compiled)
+def _to_world(pose: np.ndarray, centre: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover (compiled)
     for row in range(3):
         out[row] = pose[row, 0] * centre[0] + pose[row, 1] * centre[1] + pose[row, 2] * centre[2] + pose[row, 3]
 
 
 @njit(cache=True)
-def _sphere_touches_box(centre, radius, volumes, o):  # pragma: no cover (compiled)
+def _sphere_touches_box(centre: np.ndarray, radius: float, volumes: Volumes, o: int) -> bool:  # pragma: no cover
     """Whether a sphere (world ``centre``, ``radius``) reaches obstacle ``o``'s box."""
     gap = 0.0
     for axis in range(3):
@@ -275,14 +287,14 @@ def _sphere_touches_box(centre, radius, volumes, o):  # pragma: no cover (compil
 
 
 @njit(cache=True)
-def _spheres_touch(a, radius_a, b, radius_b):  # pragma: no cover (compiled)
+def _spheres_touch(a: np.ndarray, radius_a: float, b: np.ndarray, radius_b: float) -> bool:  # pragma: no cover
     reach = radius_a + radius_b + SLACK
     dx, dy, dz = a[0] - b[0], a[1] - b[1], a[2] - b[2]
     return dx * dx + dy * dy + dz * dz <= reach * reach
 
 
 @njit(cache=True)
-def _certified_free(q, chain, volumes, table):  # pragma: no cover (compiled)
+def _certified_free(q: np.ndarray, chain: Chain, volumes: Volumes, table: int) -> bool:  # pragma: no cover
     """Whether configuration ``q`` falls in a free cell of certified-free table ``table``."""
     index = volumes.table_start[table]
     for k in range(2):
@@ -296,7 +308,14 @@ def _certified_free(q, chain, volumes, table):  # pragma: no cover (compiled)
 
 
 @njit(cache=True)
-def screen(q, chain, volumes, poses, obstacle_hits, self_hits):  # pragma: no cover (compiled)
+def screen(
+    q: np.ndarray,
+    chain: Chain,
+    volumes: Volumes,
+    poses: np.ndarray,
+    obstacle_hits: np.ndarray,
+    self_hits: np.ndarray,
+) -> np.ndarray:  # pragma: no cover (compiled)
     """Forward kinematics and screening of configurations ``q`` (n, dof).
 
     Writes the body poses into ``poses`` (n, bodies, 4, 4), ``obstacle_hits`` (n,
@@ -344,11 +363,9 @@ def screen(q, chain, volumes, poses, obstacle_hits, self_hits):  # pragma: no co
     return maybe
 
 
-def warm_up() -> None:
-    """Compile the kernels, or load them from numba's cache, for the argument types every
-    robot's checker uses (a robot with no geometry stands in): about half a second,
-    spent here instead of in a robot's first check. The benchmark runner's forkserver
-    does this once (:mod:`ompl_balance.collision.warm_kernels`), so run processes start warm."""
+def stand_ins() -> tuple[Chain, Volumes]:
+    """A one-joint chain and the volumes of a robot without geometry: arrays of the types
+    real robots pass, for compiling the kernels ahead of use."""
     integers, reals = (lambda *shape: np.zeros(shape, dtype=np.int64)), (lambda *shape: np.zeros(shape))
     chain = Chain(
         integers(1),
@@ -381,6 +398,24 @@ def warm_up() -> None:
         integers(0),
         np.zeros(0, dtype=bool),
     )
-    q, poses = reals(1, 1), reals(1, 2, 4, 4)
+    return chain, volumes
+
+
+def warm_up() -> None:
+    """Compile the kernels, or load them from numba's cache, for the argument types every
+    robot's checker uses (a robot with no geometry stands in): about half a second,
+    spent here instead of in a robot's first check. The benchmark runner's forkserver
+    does this once (:mod:`ompl_balance.collision.warm_kernels`), so run processes start warm."""
+    chain, volumes = stand_ins()
+    q, poses = np.zeros((1, 1)), np.zeros((1, 2, 4, 4))
     screen(q, chain, volumes, poses, np.zeros((1, 0, 0), dtype=bool), np.zeros((1, 0), dtype=bool))
     _chain_poses_batch(q, chain, poses)
+
+
+def entry_point(kernel: Any, arguments: tuple[Any, ...]) -> Callable[..., Any]:
+    """The compiled function of numba ``kernel`` for the types of ``arguments``, compiled (or
+    loaded from numba's cache) now. Calling it skips numba's type dispatch (a few
+    microseconds per call), so later calls must pass arguments of exactly these types."""
+    kernel(*arguments)
+    compiled: Any = kernel.overloads[tuple(numba.typeof(a) for a in arguments)]
+    return compiled.entry_point

@@ -1,0 +1,487 @@
+"""Certified collision-free motions of a robot along straight joint-space edges.
+
+What is certified
+-----------------
+For an edge ``q(t) = a + t (b - a)``, ``t in [0, 1]``, with ``a`` and ``b`` inside the
+robot's joint bounds, :class:`MotionCertifier` proves that at every ``t`` every collision
+pair of a :class:`~ompl_balance.collision.checker.CollisionChecker`'s model is more than
+``clearance`` metres apart, or rejects the edge. The pairs are the checker's: each link
+collision geometry against each environment obstacle, and the enabled self-collision
+geometry pairs (:attr:`~ompl_balance.collision.kinematics.RobotModel.self_collision_pairs`).
+Distances are FCL's, with two conservative changes: a mesh that is (nearly) convex counts
+as its solid convex hull, and every exact distance is taken less
+:data:`~ompl_balance.collision.advancement.DISTANCE_TOLERANCE` (10 micrometres), so a pair
+that close to the clearance counts as in contact. The certificate never accepts an edge
+with a configuration FCL finds in collision. It is about the model and the straight line
+only: not the robot's visual geometry, not pairs the SRDF disables, not obstacles that
+move, not a controller's tracking error.
+
+Method
+------
+Conservative advancement (Schwarzer, Saha and Latombe, "Adaptive dynamic collision
+checking for single and multiple articulated robots in complex environments", IEEE T-RO
+21(3), 2005) with three ingredients, each in a module of its own:
+
+* a **travel bound** (:mod:`ompl_balance.collision.travel`). Along the edge a point ``p``
+  of a link moves with velocity ``sum_k v_k' w_k(p)``: joint ``k`` upstream of the link
+  changes its value at rate ``v_k'``, and ``w_k(p)`` is ``axis_k x (p - o_k)`` (``o_k`` on
+  the axis) for a revolute joint, ``axis_k`` for a prismatic one. So ``|dp/dt| <=
+  sum_k |v_k'| r_k`` where ``r_k`` bounds the distance of ``p`` from joint ``k``'s axis
+  in *every* configuration (1 for a prismatic joint), and over ``[t0, t1]`` no point
+  travels farther than ``(t1 - t0) sum_j |b_j - a_j| W[g, j]``, with ``W[g, j]`` the sum of
+  ``|m_k| r_k`` over the joints ``k`` of geometry ``g``'s chain driven by active joint
+  ``j`` (a mimic joint ``v_k = m_k q_j + c_k``). ``r_k`` is the largest distance of the
+  geometry from the axis when it hangs off joint ``k``'s own body, and otherwise the
+  component across the axis of the first link offset below the joint, plus the lengths
+  of the further offsets (prismatic ones at the end of their range), plus the geometry's
+  radius about its body frame origin. A self pair counts the joints below the two
+  geometries' lowest common ancestor body only, both geometries' weights summed: the
+  joints above move both rigidly and leave their distance alone;
+* **distance lower bounds** at a configuration (:mod:`ompl_balance.collision.convex`):
+  bounding spheres first (a link geometry's sphere against an obstacle's box or sphere,
+  two links' spheres), then GJK on the convex parts (a mesh's convex hull, which contains
+  the mesh), whose separating-plane value ``v . w / |v|`` is a lower bound at every
+  iteration, and last FCL's exact distance;
+* **advancement** (:mod:`ompl_balance.collision.advancement`): with lower bounds ``d0``,
+  ``d1`` at ``t0``, ``t1`` and travel bound ``V`` per unit ``t``, a pair stays
+  ``max(d0 - V (t - t0), d1 - V (t1 - t)) >= (d0 + d1 - V (t1 - t0)) / 2`` apart on the
+  segment, so it is certified there when ``d0 + d1 - 2 clearance > V (t1 - t0)``;
+  otherwise the segment is halved and the midpoint bounded. Pairs are independent, so a
+  pair far from contact needs a bound or two for the whole edge while a close one is cut
+  finely, and configurations at the ends of an edge keep their bounds for the next edge.
+
+A pair whose convex parts are its FCL model (primitives, convex meshes) is decided by
+GJK: an upper bound within the tolerance of the clearance is a contact. Pairs with a
+non-convex mesh (whose hull may touch where the mesh does not) are finished with FCL
+(:meth:`MotionCertifier._exact_phase`): when a segment of theirs with at most ``handover``
+metres of travel is still uncertified, a collision test at its midpoint, then FCL's exact
+distances, halving again. Self pairs with a certified-free table are certified wherever
+their straight line in the table's two joint values crosses free cells.
+
+Termination: a segment with a travel bound under :data:`MIN_TRAVEL` metres that is still
+not certified makes the edge uncertified, and contacts are decided with the tolerance
+above, so grazing edges end (rejected) after a bounded number of halvings.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import fcl
+import numpy as np
+
+from .advancement import DISTANCE_TOLERANCE, Model, Remembered, advance, hull_bounds, sphere_bounds
+from .checker import CollisionChecker
+from .convex import convex_part, pack_parts
+from .screening import entry_point, stand_ins
+from .travel import travel_weights
+
+#: A segment whose travel bound is below this (m) and is still not certified is not cut
+#: again: the edge is rejected (grazing contact).
+MIN_TRAVEL = 1e-7
+#: Travel (m) to which ``check(..., last_valid=True)`` refines the edge around its first
+#: failure before it reports the last certified fraction.
+LAST_VALID_TRAVEL = 1e-3
+
+_DISTANCE_REQUEST = fcl.DistanceRequest()
+
+
+class _EndMemory:
+    """Bounds at the last ``size`` edge end configurations: a row of arrays each, reused in turn.
+
+    Planners extend from the same tree states again and again; what the compiled phase
+    and FCL computed there is kept (as lower bounds they hold for any edge).
+    """
+
+    def __init__(self, size: int, pairs: int):
+        self.bounds = Remembered(
+            np.full((size, pairs), np.nan), np.full((size, pairs), np.inf), np.zeros((size, pairs), dtype=bool)
+        )
+        self.exact: list[dict[int, float]] = [{} for _ in range(size)]  # pair -> FCL distance
+        self._rows: dict[bytes, int] = {}
+        self._keys: list[bytes | None] = [None] * size
+        self._next = 0
+
+    def row(self, q: np.ndarray) -> int:
+        """The row of configuration ``q``, a cleared one (the oldest) if it is not remembered."""
+        key = q.tobytes()
+        row = self._rows.get(key)
+        if row is None:
+            row = self._next
+            self._next = (row + 1) % len(self._keys)
+            old = self._keys[row]
+            if old is not None:
+                del self._rows[old]
+            self._keys[row], self._rows[key] = key, row
+            self.bounds.lower[row], self.bounds.upper[row], self.bounds.final[row] = np.nan, np.inf, False
+            self.exact[row].clear()
+        return row
+
+
+class MotionCertifier:
+    """Proves straight joint-space edges free of collision for a checker's model, or rejects them.
+
+    Parameters
+    ----------
+    checker:
+        The collision model: its robot, environment and self-collision pairs. With
+        ``checker.prefilter`` false, every pair is bisected with FCL distances only (no
+        spheres, hulls or tables): slow; the reference.
+    clearance:
+        Metres: pairs closer than this count as in contact (0: touching is contact).
+    handover:
+        Travel (m) of a segment below which pairs with a non-convex mesh go to FCL.
+    remembered:
+        How many edge end configurations keep their bounds (planners extend from the
+        same states again and again).
+
+    See the module docstring for what is certified and how.
+    """
+
+    def __init__(
+        self, checker: CollisionChecker, clearance: float = 0.0, handover: float = 0.01, remembered: int = 512
+    ):
+        if not (math.isfinite(clearance) and clearance >= 0.0):
+            raise ValueError(f"clearance must be a finite number of metres >= 0, got {clearance}")
+        if not (math.isfinite(handover) and handover > 0.0):
+            raise ValueError(f"handover must be a positive number of metres, got {handover}")
+        self.checker = checker
+        self.clearance = float(clearance)
+        self.handover = float(handover)
+        self.remembered = remembered
+        self._robot = robot = checker.robot
+        self._geometries = len(robot.geometries)
+        self._obstacles = len(checker.environment.obstacles)
+        self.pair_count = self._obstacles * self._geometries + len(robot.self_collision_pairs)
+        self._model = self._build_model()
+        self._speed = np.empty(self.pair_count)
+        self._warm = np.zeros((self.pair_count, 3))
+        self._identity = np.eye(4).reshape(1, 4, 4)
+        self._hard_pair = np.empty(16, dtype=np.int64)
+        self._hard_span = np.empty((16, 4))
+        self._memory = _EndMemory(max(2, remembered), self.pair_count)
+        self._model_arguments = (robot.chain, checker._volumes, self._model, self.clearance, self.handover, MIN_TRAVEL)
+        self._scratch = (self._warm, self._speed, self._hard_pair, self._hard_span)
+        # the compiled phase is called without numba's type dispatch (several microseconds
+        # of an edge's few tens): the argument types are fixed here
+        lower = np.ascontiguousarray(robot.lower, dtype=float)
+        self._advance = entry_point(advance, self._arguments(lower, lower, 0, 0, MIN_TRAVEL, stop=True))
+
+    def _build_model(self) -> Model:
+        robot, obstacles = self._robot, self.checker.environment.obstacles
+        environment_weight, self_weight = travel_weights(robot)
+        shapes = [(g.shape, g.origin) for g in robot.geometries] + [(o.shape, o.pose) for o in obstacles]
+        parts = pack_parts([convex_part(s.kind, s.dims, s.hull_vertices(), pose) for s, pose in shapes])
+        around = []
+        for obstacle in obstacles:
+            centre, radius = obstacle.shape.bounding_spheres(1)
+            around.append((obstacle.pose[:3, :3] @ centre[0] + obstacle.pose[:3, 3], radius[0]))
+        convex = [s.convex for s, _ in shapes]
+        solid = np.array(
+            [
+                convex[g] and convex[self._geometries + o]
+                for o in range(self._obstacles)
+                for g in range(self._geometries)
+            ]
+            + [convex[a] and convex[b] for a, b in robot.self_collision_pairs],
+            dtype=bool,
+        )
+        fixed = np.full(self.pair_count, np.nan)
+        still = ~environment_weight.any(axis=1)  # geometries no joint moves
+        if still.any():
+            poses = robot.body_poses(np.zeros(robot.dof))[0]
+            for o in range(self._obstacles):
+                for g in np.flatnonzero(still):
+                    fixed[o * self._geometries + g] = max(self._fcl_distance(o * self._geometries + g, poses), -1.0)
+        return Model(
+            parts=parts,
+            obstacle_centre=np.array([c for c, _ in around], dtype=float).reshape(-1, 3),
+            obstacle_radius=np.array([r for _, r in around], dtype=float),
+            environment_weight=environment_weight,
+            self_weight=self_weight.reshape(-1, robot.dof),
+            fixed=fixed,
+            solid=solid,
+            joint_lower=np.ascontiguousarray(robot.lower, dtype=float),
+            joint_upper=np.ascontiguousarray(robot.upper, dtype=float),
+        )
+
+    # ------------------------------------------------------------------ public API
+
+    def check(self, a: np.ndarray, b: np.ndarray, last_valid: bool = False) -> tuple[bool, float]:
+        """Whether the edge ``a -> b`` (dof,) is certified, and the fraction of it certified.
+
+        Counts one motion, the configurations evaluated and the FCL distance queries in the
+        checker's counter. Non-finite or out-of-bounds ends: not certified, fraction 0.
+        Without ``last_valid`` the work stops at the first failure and a rejected edge
+        reports fraction 0. With ``last_valid`` the edge is refined around its first
+        failure to :data:`LAST_VALID_TRAVEL` of travel, and ``a + s (b - a)`` is
+        certified for every ``s`` up to the fraction returned.
+        """
+        counter = self.checker.counter
+        counter.motions_checked += 1
+        a = np.ascontiguousarray(a, dtype=float)
+        b = np.ascontiguousarray(b, dtype=float)
+        if a.shape != (self._robot.dof,) or b.shape != a.shape:
+            return False, 0.0
+        start, end = self._memory.row(a), self._memory.row(b)
+        settle = max(MIN_TRAVEL, LAST_VALID_TRAVEL) if last_valid else MIN_TRAVEL
+        if self.checker.prefilter:
+            failed, bad, hard, evaluated, bounded, hard_pair, hard_span = self._advance(
+                *self._arguments(a, b, start, end, settle, stop=not last_valid)
+            )
+            if hard_pair is not self._hard_pair:  # grown
+                self._hard_pair, self._hard_span = hard_pair, hard_span
+                self._scratch = (self._warm, self._speed, self._hard_pair, self._hard_span)
+            counter.states_checked += evaluated
+            counter.distance_queries += bounded
+            if failed and (not last_valid or bad == 0.0):
+                return False, 0.0
+            if hard == 0:
+                return (False, bad) if failed else (True, 1.0)
+            pairs, spans = self._hard_pair[:hard], self._hard_span[:hard]
+        else:  # the reference: every pair over the whole edge with FCL only
+            if not (self._inside(a) and self._inside(b)):
+                return False, 0.0
+            delta = np.abs(b - a)
+            per_geometry = self._model.environment_weight @ delta
+            self._speed[:] = np.concatenate([np.tile(per_geometry, self._obstacles), self._model.self_weight @ delta])
+            failed, bad = False, 1.0
+            pairs = np.arange(self.pair_count)
+            spans = np.tile([0.0, 1.0, -np.inf, -np.inf], (self.pair_count, 1))
+        failed, bad = self._exact_phase(a, b, pairs, spans, start, end, settle, last_valid, failed, bad)
+        if failed:
+            return False, bad if last_valid else 0.0
+        return True, 1.0
+
+    def _arguments(self, a: np.ndarray, b: np.ndarray, start: int, end: int, settle: float, stop: bool) -> tuple:
+        """The arguments of :func:`~ompl_balance.collision.advancement.advance` for the edge ``a -> b``."""
+        return (a, b, *self._model_arguments, settle, stop, self._memory.bounds, start, end, *self._scratch)
+
+    def closest(self, q: np.ndarray) -> float:
+        """The smallest FCL distance (m) between the collision pairs at configuration ``q`` (dof,).
+
+        At most 0 in contact. Pairs whose lower bound exceeds the best so far are skipped.
+        """
+        q = np.ascontiguousarray(q, dtype=float)
+        poses = self._robot.body_poses(q)[0]
+        warm = np.zeros((self.pair_count, 3))
+        volumes = self.checker._volumes
+        pairs = np.arange(self.pair_count)
+        lower = np.empty(self.pair_count)
+        sphere_bounds(poses, volumes, self._model, pairs, lower)
+        for pair in range(self.pair_count):
+            lower[pair] = max(lower[pair], hull_bounds(pair, poses, volumes, self._model, warm, self._identity, 0.0)[0])
+        best = np.inf
+        for pair in np.argsort(lower):
+            if lower[pair] >= best:
+                break
+            best = min(best, self._fcl_distance(pair, poses) + DISTANCE_TOLERANCE)
+            if best <= 0.0:
+                return 0.0
+        return float(best)
+
+    # ------------------------------------------------------------------ internals
+
+    def _inside(self, q: np.ndarray) -> bool:
+        robot = self._robot
+        return bool(q.shape == (robot.dof,) and np.all(q >= robot.lower) and np.all(q <= robot.upper))
+
+    def _objects(self, pair: int) -> tuple[fcl.CollisionObject, fcl.CollisionObject, tuple[int, ...]]:
+        """The FCL objects of ``pair`` and the link geometries among them."""
+        checker = self.checker
+        if pair < self._obstacles * self._geometries:
+            o, g = divmod(pair, self._geometries)
+            return checker._links[g], checker._obstacles[o], (g,)
+        a, b = self._robot.self_collision_pairs[pair - self._obstacles * self._geometries]
+        return checker._links[a], checker._links[b], (a, b)
+
+    def _touching(self, pair: int, poses: np.ndarray) -> bool:
+        """FCL's collision test of ``pair`` at body ``poses``."""
+        first, second, links = self._objects(pair)
+        for g in links:
+            self.checker._place(poses, g)
+        return bool(fcl.collide(first, second, self.checker._request, fcl.CollisionResult()))
+
+    def _fcl_distance(self, pair: int, poses: np.ndarray) -> float:
+        """FCL's distance of ``pair`` at body ``poses`` less the tolerance; ``-inf`` in contact."""
+        if self._touching(pair, poses):
+            return -np.inf
+        first, second, _links = self._objects(pair)
+        self.checker.counter.distance_queries += 1
+        return fcl.distance(first, second, _DISTANCE_REQUEST, fcl.DistanceResult()) - DISTANCE_TOLERANCE
+
+    def _exact_phase(
+        self,
+        a: np.ndarray,
+        b: np.ndarray,
+        pairs: np.ndarray,
+        spans: np.ndarray,
+        start: int,
+        end: int,
+        settle: float,
+        last_valid: bool,
+        failed: bool,
+        bad: float,
+    ) -> tuple[bool, float]:
+        """Certify the hard segments (pair, (t0, t1, d0, d1)) with FCL.
+
+        ``failed`` and ``bad``: what the compiled phase found (the edge certified on
+        ``[0, bad]`` but for the hard segments). Returns them updated; without
+        ``last_valid`` it returns at the first failure. Segments reaching a failure are
+        refined to ``settle`` metres of travel only.
+        """
+        clearance, speed, delta = self.clearance, self._speed, b - a
+        poses_at: dict[float, np.ndarray] = {}
+        exact: dict[tuple[int, float], float] = {}
+
+        def poses(t: float) -> np.ndarray:
+            if t not in poses_at:
+                poses_at[t] = self._robot.body_poses(a + t * delta)[0]
+                self.checker.counter.states_checked += 1
+            return poses_at[t]
+
+        def distance(pair: int, t: float) -> float:
+            known = self._memory.exact[start] if t == 0.0 else self._memory.exact[end] if t == 1.0 else None
+            if known is not None and pair in known:
+                return known[pair]
+            if (pair, t) not in exact:
+                exact[pair, t] = self._fcl_distance(pair, poses(t))
+                if known is not None:
+                    known[pair] = exact[pair, t]
+            return exact[pair, t]
+
+        if not last_valid:  # contacts first: an FCL collision test costs a few microseconds
+            for pair, (t0, t1, _, _) in zip(pairs.tolist(), spans.tolist()):
+                if self._touching(pair, poses(0.5 * (t0 + t1))):
+                    return True, 0.0
+        order = np.argsort(spans[:, 0] - spans[:, 1], kind="stable")  # widest first: coarse to fine
+        queue = deque((int(pairs[i]), *spans[i].tolist()) for i in order)
+        while queue:
+            pair, t0, t1, d0, d1 = queue.popleft()
+            if t0 >= bad:
+                continue
+            travel = speed[pair] * (t1 - t0)
+            for t in (t0, t1) if d0 <= d1 else (t1, t0):  # the smaller bound first
+                if d0 + d1 - 2.0 * clearance > travel:
+                    break
+                # both are lower bounds; an exact -inf (contact) is a fact
+                if t == t0:
+                    d0 = _sharper(d0, distance(pair, t))
+                else:
+                    d1 = _sharper(d1, distance(pair, t))
+            if d0 + d1 - 2.0 * clearance > travel:
+                continue
+            for t, d in ((t0, d0), (t1, d1)):
+                if d <= clearance:  # (exact: the sharpening reached it)
+                    failed = True
+                    if not last_valid:
+                        return True, 0.0
+                    bad = min(bad, t)
+            if travel < MIN_TRAVEL or t0 >= bad or (failed and t1 >= bad and travel < settle):
+                failed = True
+                if not last_valid:
+                    return True, 0.0
+                bad = min(bad, t0)
+                continue
+            middle = 0.5 * (t0 + t1)
+            dm = distance(pair, middle)
+            queue.append((pair, t0, middle, d0, dm))
+            queue.append((pair, middle, t1, dm, d1))
+        return failed, bad
+
+
+def _sharper(bound: float, exact: float) -> float:
+    """The better of a lower bound and an exact distance (``-inf``: contact, which stands)."""
+    return exact if exact == -np.inf else max(bound, exact)
+
+
+@dataclass(frozen=True)
+class PathCertificate:
+    """The answer of :func:`certify_states` (and :func:`ompl_balance.validity.certify_path`).
+
+    ``certified``: every segment is certified free with ``clearance`` (m) to spare.
+    ``segments``: how many segments the path has. ``first_bad_segment``: index ``i`` of the
+    first segment ``states[i] -> states[i + 1]`` not certified (``None`` if all are), and
+    ``certified_fraction`` how much of it is certified from ``states[i]`` on (1 if all are).
+    ``smallest_clearance``: the smallest FCL distance (m) between any collision pair at the
+    path's states (at most 0: a state in contact); the path's true smallest clearance is at
+    most this, and more than ``clearance`` when ``certified``.
+    """
+
+    certified: bool
+    segments: int
+    first_bad_segment: int | None
+    certified_fraction: float
+    smallest_clearance: float
+    clearance: float
+
+
+def certify_states(checker: CollisionChecker, states: np.ndarray, clearance: float = 0.0) -> PathCertificate:
+    """Certify the straight joint-space segments between consecutive ``states`` (n, dof).
+
+    Raises ``ValueError`` for a wrong shape or non-finite values; a state outside the joint
+    bounds leaves its segments uncertified.
+    """
+    states = checker.robot.as_array(states)
+    if len(states) == 0:
+        raise ValueError("a path needs at least one state")
+    certifier = MotionCertifier(checker, clearance)
+    first_bad, fraction = None, 1.0
+    for i in range(len(states) - 1):
+        ok, fraction = certifier.check(states[i], states[i + 1], last_valid=True)
+        if not ok:
+            first_bad = i
+            break
+    inside = [certifier._inside(q) for q in states]
+    smallest = min(certifier.closest(q) if ok else -np.inf for q, ok in zip(states, inside))
+    certified = first_bad is None and all(inside) and smallest > clearance + DISTANCE_TOLERANCE
+    return PathCertificate(
+        certified=certified,
+        segments=len(states) - 1,
+        first_bad_segment=first_bad,
+        certified_fraction=fraction if first_bad is not None else 1.0,
+        smallest_clearance=smallest,
+        clearance=clearance,
+    )
+
+
+def warm_up() -> None:
+    """Compile the advancement kernel, or load it from numba's cache, for the argument types
+    every certifier passes (a robot without geometry stands in), as
+    :func:`~ompl_balance.collision.screening.warm_up` does for the checker's kernels."""
+    chain, volumes = stand_ins()
+    model = Model(
+        parts=pack_parts([]),
+        obstacle_centre=np.zeros((0, 3)),
+        obstacle_radius=np.zeros(0),
+        environment_weight=np.zeros((0, 1)),
+        self_weight=np.zeros((0, 1)),
+        fixed=np.zeros(0),
+        solid=np.zeros(0, dtype=bool),
+        joint_lower=np.zeros(1),
+        joint_upper=np.zeros(1),
+    )
+    q = np.zeros(1)
+    hard_pair, hard_span = np.zeros(1, dtype=np.int64), np.zeros((1, 4))
+    memory = _EndMemory(2, 0).bounds
+    advance(
+        q,
+        q,
+        chain,
+        volumes,
+        model,
+        0.0,
+        0.01,
+        MIN_TRAVEL,
+        MIN_TRAVEL,
+        True,
+        memory,
+        0,
+        1,
+        np.zeros((0, 3)),
+        q[:0],
+        hard_pair,
+        hard_span,
+    )
