@@ -33,9 +33,9 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ompl_balance.core.counting import CountingValidityChecker, measured_solve
+from ompl_balance.core.counting import measured_solve
 from ompl_balance.planners import PRESETS
-from ompl_balance.worlds.boxes import PROBLEMS, Problem
+from ompl_balance.worlds.boxes import PROBLEMS, TWIN_POCKETS, circle_setup
 
 #: The report's averages: (time s, nodes, collision queries); "plain" is RRT-Connect.
 REPORT = {
@@ -72,34 +72,6 @@ STRICT = {
 
 #: A ratio within this band of 1 reads as "same": differences of less than 10 %.
 SAME_BAND = 0.1
-
-TWIN_POCKETS = Problem(
-    "twin_pockets",
-    "start and goal in pockets opening away from each other",
-    (
-        (0.22, 0.60, 0.45, 0.62),
-        (0.22, 0.38, 0.45, 0.40),
-        (0.43, 0.38, 0.45, 0.62),
-        (0.55, 0.60, 0.78, 0.62),
-        (0.55, 0.38, 0.78, 0.40),
-        (0.55, 0.38, 0.57, 0.62),
-    ),
-    (0.35, 0.5),
-    (0.65, 0.5),
-)
-
-
-def circle_setup() -> og.SimpleSetup:
-    """SO(2) with an obstacle between 0.5 and 1.0 rad; start 0, goal 1.5."""
-    space = ob.SO2StateSpace()
-    ss = og.SimpleSetup(space)
-    si = ss.getSpaceInformation()
-    si.setStateValidityChecker(CountingValidityChecker(si, lambda state: not 0.5 <= state.value <= 1.0))
-    start, goal = space.allocState(), space.allocState()
-    start.value, goal.value = 0.0, 1.5
-    ss.setStartAndGoalStates(start, goal)
-    return ss
-
 
 SETUPS: dict[str, Callable[[], og.SimpleSetup]] = {
     **{name: problem.setup for name, problem in PROBLEMS.items()},

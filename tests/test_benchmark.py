@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 import sqlite3
@@ -136,6 +137,20 @@ def test_mbm_problems_expand_ids_and_ranges(tmp_path):
         load_experiment(write(tmp_path, text.replace('"10-12"', '"10-101"')))
 
 
+def test_mbm_problems_select_the_motion_validator(tmp_path):
+    """Certified motions by default; ``motion = "discrete"`` installs OMPL-style discrete checking."""
+    from ompl_balance.validity import CertifiedMotionValidator, MotionValidator
+
+    def problem(extra: str) -> str:
+        return GOOD.replace('builtin = "open"', 'mbm = "box"\nids = [1]' + extra)
+
+    for extra, validator in (("", CertifiedMotionValidator), ('\nmotion = "discrete"', MotionValidator)):
+        ss = load_experiment(write(tmp_path, problem(extra))).problems[0].build()
+        assert type(ss.getSpaceInformation().getMotionValidator()) is validator
+    with pytest.raises(ExperimentError, match=r"problems\[0\].motion: must be one of certified, discrete"):
+        load_experiment(write(tmp_path, problem('\nmotion = "exact"')))
+
+
 def test_planner_list_syntax_of_compare():
     specs = parse_planners("RRTConnect,BalancedRRTConnect[max_tree_size_ratio=0.5;range=0.1],RRT")
     assert [s.label for s in specs] == ["RRTConnect", "BalancedRRTConnect[max_tree_size_ratio=0.5;range=0.1]", "RRT"]
@@ -186,6 +201,19 @@ def test_a_run_re_executed_alone_repeats_its_result(tiny_sweep):
     by_key = {(r["problem"], r["planner"], r["run"]): r for r in records}
     for task in [t for t in experiment.tasks() if t.problem.name == "narrow_gap" and t.run == 1]:
         assert deterministic(run_isolated(task)) == deterministic(by_key[task.key])
+
+
+def test_the_warm_up_solve_is_neither_timed_nor_counted(tiny_sweep):
+    """BalancedRRTConnect samples from the run's seed in numpy, so its timed solve does the same
+    work with and without the warm-up solve before it: any leak of the warm-up's work would show."""
+    experiment, _, _ = tiny_sweep
+    task = next(
+        t for t in experiment.tasks() if t.planner.name == "BalancedRRTConnect" and t.problem.name == "narrow_gap"
+    )
+    assert task.warm_up
+    warm, cold = run_isolated(task), run_isolated(dataclasses.replace(task, warm_up=False))
+    for name in ("validity checks INTEGER", "motion checks INTEGER", "iterations INTEGER", "solution length REAL"):
+        assert warm["properties"][name] == cold["properties"][name], name
 
 
 def test_rerun_runs_nothing_and_more_runs_add_only_the_missing(tmp_path):

@@ -9,38 +9,25 @@ advancement, FCL distances.
 """
 
 import itertools
-from pathlib import Path
 
 import fcl
 import numpy as np
 import pytest
 from ompl import base as ob
 from ompl import geometric as og
+from test_validity import arm3_scene
 
 import ompl_balance
 from ompl_balance import BalancedRRTConnect
 from ompl_balance.collision import certified
 from ompl_balance.collision.checker import CollisionChecker, Environment
-from ompl_balance.collision.kinematics import RobotModel
 from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.collision.travel import travel_weights
 from ompl_balance.core.counting import read_work
 from ompl_balance.validity import CertifiedMotionValidator, MotionValidator, certify_path, setup_robot, space_for
 from ompl_balance.worlds.mbm import SCENARIOS, load_mbm
 
-ROBOTS = Path(__file__).resolve().parent / "robots"
 STEP = 1e-4  # rad: the oracle's resolution in every joint
-
-
-def arm3_scene():
-    """The test arm (continuous, revolute, prismatic and mimic joints) among a box, a sphere, a cylinder and a mesh."""
-    robot = RobotModel.from_urdf(ROBOTS / "arm3.urdf", ROBOTS / "arm3.srdf", package_map={"testbot": str(ROBOTS)})
-    environment = Environment()
-    environment.add_box("wall", [0.05, 0.4, 0.3], [0.55, 0.0, 0.3], [0.0, 0.0, 0.3826834, 0.9238795])
-    environment.add_sphere("ball", 0.1, [-0.3, 0.35, 0.5])
-    environment.add_cylinder("post", 0.05, 0.8, [-0.1, -0.5, 0.4], [0.3826834, 0.0, 0.0, 0.9238795])
-    environment.add_mesh("cone", ROBOTS / "meshes" / "cone.obj", [0.0, 0.45, 0.2])
-    return robot, environment
 
 
 _PANDA = {}
@@ -174,7 +161,7 @@ def test_travel_bound_holds_for_sampled_points_and_is_not_loose(robot_name):
 
 def test_travel_bound_too_small_certifies_a_colliding_edge(monkeypatch):
     # the certificate rests on the travel bound: scaled by 0.2 it lets colliding edges through
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     oracle = CollisionChecker(robot, environment)
     scaled = lambda robot: tuple(0.2 * w for w in travel_weights(robot))  # noqa: E731
     monkeypatch.setattr(certified, "travel_weights", scaled)
@@ -187,7 +174,7 @@ def test_travel_bound_too_small_certifies_a_colliding_edge(monkeypatch):
 
 
 def test_random_edges_arm3_every_obstacle_kind():
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     assert {o.shape.kind for o in environment.obstacles} == {"box", "sphere", "cylinder", "mesh"}
     edges = random_edges(robot, CollisionChecker(robot, environment), 150, np.random.default_rng(3))
     certified_count, free_count = check_edges(robot, environment, edges)
@@ -207,7 +194,7 @@ def test_random_edges_panda(scenario):
 @pytest.mark.slow
 @pytest.mark.parametrize("scenario", ["arm3", *SCENARIOS])
 def test_random_edges_many(scenario):
-    robot, environment = arm3_scene() if scenario == "arm3" else panda_scene(scenario)
+    robot, environment = arm3_scene()[:2] if scenario == "arm3" else panda_scene(scenario)
     edges = random_edges(robot, CollisionChecker(robot, environment), 2000, np.random.default_rng(5))
     certified_count, free_count = check_edges(robot, environment, edges)
     assert certified_count >= 0.9 * free_count
@@ -249,7 +236,7 @@ def grazing_edges(robot, environment, count, rng, longest=0.8):
 @pytest.mark.parametrize("scene", ["arm3", "panda"])
 def test_grazing_edges(scene):
     # 1e-5 rad apart in joint space: the colliding one is rejected, its lastValid prefix is free
-    robot, environment = arm3_scene() if scene == "arm3" else panda_scene("table_pick")
+    robot, environment = arm3_scene()[:2] if scene == "arm3" else panda_scene("table_pick")
     pairs = grazing_edges(robot, environment, 4, np.random.default_rng(6), longest=0.5)
     check_edges(robot, environment, [edge for colliding, free, *_ in pairs for edge in (colliding, free)])
 
@@ -258,7 +245,7 @@ def test_grazing_edges(scene):
 @pytest.mark.parametrize("scenario", ["arm3", "self-collision", *SCENARIOS])
 def test_grazing_edges_many(scenario):
     if scenario == "arm3":
-        robot, environment = arm3_scene()
+        robot, environment = arm3_scene()[:2]
     elif scenario == "self-collision":
         robot, environment = panda(), Environment()
     else:
@@ -282,7 +269,7 @@ def test_self_collision_edges_panda():
 def test_prefilter_off_reference_agrees():
     # the reference (FCL distances only, no spheres, hulls or tables) is safe too, and both
     # certify the clearly free edges
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     reference = certified.MotionCertifier(CollisionChecker(robot, environment, prefilter=False))
     fast = certified.MotionCertifier(CollisionChecker(robot, environment))
     edges = random_edges(robot, CollisionChecker(robot, environment), 25, np.random.default_rng(9), longest=0.6)
@@ -309,7 +296,7 @@ def test_non_convex_meshes_are_finished_with_fcl(monkeypatch):
     # link6 (not convex either): their pairs near contact go to FCL's exact distance
     import trimesh
 
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     environment.add_mesh("ring", trimesh.creation.annulus(0.25, 0.32, 0.06), [0.0, 0.0, 0.45])
     assert not environment.obstacles[-1].shape.convex
     calls = []
@@ -327,7 +314,7 @@ def test_non_convex_meshes_are_finished_with_fcl(monkeypatch):
 
 def test_far_edges_need_few_bounds():
     # a short edge far from everything: the two ends, no distance query, fewer states than OMPL's resolution
-    robot, _ = arm3_scene()
+    robot, _ = arm3_scene()[:2]
     environment = Environment()
     environment.add_box("far", [0.1, 0.1, 0.1], [5.0, 0.0, 0.0])
     checker = CollisionChecker(robot, environment)
@@ -364,7 +351,7 @@ def fcl_clearance(robot, environment, q):
 
 
 def test_clearance_is_kept():
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     clearance = 0.04
     keeping = certified.MotionCertifier(CollisionChecker(robot, environment), clearance=clearance)
     edges = random_edges(robot, CollisionChecker(robot, environment), 30, np.random.default_rng(11), longest=0.6)
@@ -389,7 +376,7 @@ def test_clearance_is_kept():
 
 
 def test_bad_input_is_invalid_not_an_exception():
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     checker = CollisionChecker(robot, environment)
     ss = og.SimpleSetup(space_for(robot))
     _validity, validator = setup_robot(ss, checker)
@@ -409,7 +396,7 @@ def test_bad_input_is_invalid_not_an_exception():
 
 
 def test_setup_robot_motion_names():
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     checker = CollisionChecker(robot, environment)
     for motion, kind in (("certified", CertifiedMotionValidator), ("discrete", MotionValidator)):
         ss = og.SimpleSetup(space_for(robot))
@@ -424,7 +411,7 @@ def test_setup_robot_motion_names():
 
 
 def test_certify_path_arrays_and_ompl_paths():
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     checker = CollisionChecker(robot, environment)
     oracle = CollisionChecker(robot, environment)
     rng = np.random.default_rng(12)
@@ -462,7 +449,7 @@ def test_warm_up_compiles_the_kernel_real_certifiers_use():
     from ompl_balance.collision.advancement import advance
 
     certified.warm_up()
-    robot, environment = arm3_scene()
+    robot, environment = arm3_scene()[:2]
     certifier = certified.MotionCertifier(CollisionChecker(robot, environment))
     certifier.check(np.zeros(3), np.full(3, 0.1))
     assert len(advance.signatures) == 1

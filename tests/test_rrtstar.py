@@ -89,7 +89,7 @@ def test_best_cost_never_increases_and_matches_the_iterations():
 
 
 def test_estimated_gamma_beats_the_default_of_100_at_equal_iterations():
-    """The claim of issue 4: with gamma = 100 the 40 m map's ball is nearly empty and the cost stalls."""
+    """With gamma = 100 (MATLAB's default) the 40 m map's ball is nearly empty and the cost stalls."""
     problem = rooms_problem()
     final = {}
     for gamma in ("100", "auto"):

@@ -35,7 +35,7 @@ from ompl_balance.policies import (
     tree_chooser,
 )
 from ompl_balance.samplers import GaussianValidStateSampler
-from ompl_balance.worlds.boxes import Problem, get_problem
+from ompl_balance.worlds.boxes import TWIN_POCKETS, circle_setup, get_problem
 
 ALTERNATE, BALANCE, STEPS, COLLISION = SwapCause
 
@@ -587,24 +587,6 @@ def test_goal_ball_takes_a_uniform_target_at_the_uniform_rate(rate):
     assert counts.rejections == (n - uniform) * SAMPLE_ATTEMPTS
 
 
-#: Start and goal each in a pocket that opens away from the other: every way out of a pocket
-#: leaves the ball around the other root whose radius is the start-goal distance (0.3).
-TWIN_POCKETS = Problem(
-    "twin_pockets",
-    "start and goal in pockets opening away from each other",
-    (
-        (0.22, 0.60, 0.45, 0.62),
-        (0.22, 0.38, 0.45, 0.40),
-        (0.43, 0.38, 0.45, 0.62),
-        (0.55, 0.60, 0.78, 0.62),
-        (0.55, 0.38, 0.78, 0.40),
-        (0.55, 0.38, 0.57, 0.62),
-    ),
-    (0.35, 0.5),
-    (0.65, 0.5),
-)
-
-
 def test_control_chosen_solves_what_stock_solves_and_the_strict_rule_cannot():
     ss = TWIN_POCKETS.setup()
     ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
@@ -632,32 +614,21 @@ def test_control_chosen_solves_what_stock_solves_and_the_strict_rule_cannot():
         assert np.all(np.linalg.norm(tree.states - np.array(centre), axis=1) <= radius + 1e-9)
 
 
-def so2_setup() -> og.SimpleSetup:
-    """A circle with an obstacle between 0.5 and 1.0 rad; start 0, goal 1.5: the way goes round."""
-    space = ob.SO2StateSpace()
-    ss = og.SimpleSetup(space)
-    ss.setStateValidityChecker(lambda state: not 0.5 <= state.value <= 1.0)
-    start, goal = space.allocState(), space.allocState()
-    start.value, goal.value = 0.0, 1.5
-    ss.setStartAndGoalStates(start, goal)
-    return ss
-
-
 @pytest.mark.parametrize("preset", ["GaussianPassageRRTConnect", "NeighbourCostRRTConnect"])
 def test_presets_solve_the_circle_in_every_run_and_their_strict_rules_do_not(preset):
     """Near obstacles only (the passage sampler), or never from the costliest node (neighbour
     quality with min_quality 0): the far side of the circle is never targeted."""
-    ss = so2_setup()
+    ss = circle_setup()
     ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
     assert ss.solve(2.0) == ob.PlannerStatus.EXACT_SOLUTION
     for _ in range(5):
-        ss = so2_setup()
+        ss = circle_setup()
         planner = PRESETS[preset](ss.getSpaceInformation())
         ss.setPlanner(planner)
         assert ss.solve(2.0) == ob.PlannerStatus.EXACT_SOLUTION
         path = ss.getSolutionPath()
         assert path.check() and all(not 0.5 <= path.getState(i).value <= 1.0 for i in range(path.getStateCount()))
-    ss = so2_setup()
+    ss = circle_setup()
     planner = PRESETS[preset](ss.getSpaceInformation())
     planner.setUniformRate(0.0)
     ss.setPlanner(planner)

@@ -9,6 +9,7 @@ Experiments come from TOML files (:func:`load_experiment`) or from Python::
     time_limit = 1.0           # seconds of planning per run
     memory_limit = 0           # MB a run may add to its memory (as OMPL), 0 = no limit
     seed = 1                   # decides every run's seed (see run_seed)
+    warm_up = true             # an untimed short solve before each timed one (runner.warm_up)
     baseline = "RRTConnect"    # planner label the summary's ratios refer to
 
     [[problems]]
@@ -20,6 +21,8 @@ Experiments come from TOML files (:func:`load_experiment`) or from Python::
     ids = [1, 2, "10-19"]                      # problem ids; default: all
     # robot = "my/panda_vamp"                  # another folder with panda.urdf + panda.srdf
                                                # (default: the Panda shipped with the package)
+    # motion = "discrete"                      # the motion validator: "certified" (default)
+                                               # or "discrete" (OMPL-style states only)
 
     [[problems]]
     factory = "mypackage.worlds:make_setup"    # function(**args) -> og.SimpleSetup
@@ -190,8 +193,8 @@ class ProblemSpec:
 
     ``kind`` is ``"builtin"`` (``source`` names one of ``ompl_balance.worlds.boxes.PROBLEMS``),
     ``"mbm"`` (``source`` is a shipped MotionBenchMaker scenario or a JSON file,
-    ``problem_id`` the problem's id and ``robot`` the robot folder, empty for the shipped
-    Panda) or ``"factory"`` (``source`` is ``"module:function"`` called with ``args``).
+    ``problem_id`` the problem's id, ``robot`` the robot folder, empty for the shipped
+    Panda, and ``motion`` the motion validator, ``"certified"`` or ``"discrete"``) or ``"factory"`` (``source`` is ``"module:function"`` called with ``args``).
     ``name`` is unique in the experiment and names its log file. ``data`` is a digest of
     the files a MotionBenchMaker problem is read from when they are not shipped with the
     package (:func:`mbm_problems` fills it), so that an edited file makes a new problem.
@@ -204,6 +207,7 @@ class ProblemSpec:
     robot: str = ""
     args: Mapping[str, Any] = field(default_factory=dict)
     data: str = ""
+    motion: str = ""
 
     def build(self) -> og.SimpleSetup:
         """A fresh ``SimpleSetup`` with start, goal and a counting validity checker."""
@@ -212,7 +216,7 @@ class ProblemSpec:
         elif self.kind == "mbm":
             from ..worlds.mbm import problem_setup
 
-            ss = problem_setup(self.source, self.problem_id, self.robot)
+            ss = problem_setup(self.source, self.problem_id, self.robot, self.motion or "certified")
         else:
             ss = _import_function(self.source)(**self.args)
             if not isinstance(ss, og.SimpleSetup):
@@ -221,10 +225,13 @@ class ProblemSpec:
         return ss
 
 
-def mbm_problems(scenario: str, ids: Sequence[int] | None = None, robot: str = "") -> list[ProblemSpec]:
+def mbm_problems(
+    scenario: str, ids: Sequence[int] | None = None, robot: str = "", motion: str = "certified"
+) -> list[ProblemSpec]:
     """Specs of MotionBenchMaker problems, named ``<scenario>.NNN``: a shipped scenario by name or
     a JSON file (absolute path), ``ids`` (default: all), ``robot`` a folder with ``panda.urdf``
-    and ``panda.srdf`` (default: the shipped Panda). ``ValueError`` for what cannot be read."""
+    and ``panda.srdf`` (default: the shipped Panda), ``motion`` the motion validator
+    (``"certified"`` or ``"discrete"``). ``ValueError`` for what cannot be read."""
     from ..worlds.mbm import load_mbm
 
     problems = load_mbm(scenario)
@@ -233,18 +240,23 @@ def mbm_problems(scenario: str, ids: Sequence[int] | None = None, robot: str = "
     if missing:
         raise ValueError(f"ids {missing} not in the file (it has {min(available)}..{max(available)})")
     name = problems[0].scenario if problems else Path(scenario).stem
-    return _mbm_specs(name, scenario, available if ids is None else list(ids), robot)
+    return _mbm_specs(name, scenario, available if ids is None else list(ids), robot, motion)
 
 
-def _mbm_specs(name: str, source: str, ids: Sequence[int], robot: str) -> list[ProblemSpec]:
+def _mbm_specs(name: str, source: str, ids: Sequence[int], robot: str, motion: str) -> list[ProblemSpec]:
     """Specs of the problems ``ids`` of a scenario, with the digest of its files unless shipped."""
+    from ..validity import MOTION_VALIDATORS
     from ..worlds.mbm import SCENARIOS, files_digest
 
     files = [] if source in SCENARIOS else [Path(source)]
     if robot:
         files += [Path(robot) / "panda.urdf", Path(robot) / "panda.srdf"]
     data = files_digest(files) if files else ""
-    return [ProblemSpec(f"{name}.{i:03d}", "mbm", source, problem_id=i, robot=robot, data=data) for i in ids]
+    if motion not in MOTION_VALIDATORS:
+        raise ValueError(f"motion must be one of {', '.join(MOTION_VALIDATORS)}, got {motion!r}")
+    return [
+        ProblemSpec(f"{name}.{i:03d}", "mbm", source, problem_id=i, robot=robot, data=data, motion=motion) for i in ids
+    ]
 
 
 # -- the experiment ---------------------------------------------------------------------
@@ -283,6 +295,7 @@ class RunTask:
     memory_limit: float  # MB the run may add to its process's memory (runner.MemoryLimit), 0 = no limit
     hard_limit: float  # s of wall clock after which the run's process is killed
     definition: str = ""  # digest of the cell's definition (Experiment.cell_definition)
+    warm_up: bool = True  # an untimed short solve before the timed one (runner.warm_up)
 
     @property
     def key(self) -> tuple[str, str, int]:
@@ -292,7 +305,7 @@ class RunTask:
 HARD_LIMIT_MARGIN = 5.0  # s added to 2 x the time limit before a run is killed
 
 #: The experiment's fields that define every run's result (besides its problem and planner).
-RUN_DEFINING_FIELDS = ("seed", "time_limit", "memory_limit", "hard_limit_margin")
+RUN_DEFINING_FIELDS = ("seed", "time_limit", "memory_limit", "hard_limit_margin", "warm_up")
 
 
 @dataclass(frozen=True)
@@ -308,6 +321,7 @@ class Experiment:
     seed: int = 1
     baseline: str = ""
     hard_limit_margin: float = HARD_LIMIT_MARGIN
+    warm_up: bool = True
 
     def __post_init__(self) -> None:
         check_experiment(self)
@@ -340,6 +354,7 @@ class Experiment:
                 self.memory_limit,
                 2 * self.time_limit + self.hard_limit_margin,
                 definitions[problem.name, planner.label],
+                self.warm_up,
             )
             for run in range(self.runs)
             for problem in self.problems
@@ -382,6 +397,8 @@ def check_experiment(experiment: Experiment) -> None:
             raise ExperimentError(
                 key, f"must be a {'positive' if positive else 'non-negative'} finite number, got {value!r}"
             )
+    if not isinstance(experiment.warm_up, bool):
+        raise ExperimentError("warm_up", f"must be true or false, got {experiment.warm_up!r}")
     if isinstance(experiment.seed, bool) or not isinstance(experiment.seed, int) or experiment.seed < 0:
         raise ExperimentError("seed", f"must be a whole number >= 0, got {experiment.seed!r}")
     if not experiment.problems:
@@ -419,10 +436,11 @@ _TOP_KEYS = {
     "seed",
     "baseline",
     "hard_limit_margin",
+    "warm_up",
     "problems",
     "planners",
 }
-_PROBLEM_KEYS = {"builtin": set(), "mbm": {"robot", "ids"}, "factory": {"name", "args"}}
+_PROBLEM_KEYS = {"builtin": set(), "mbm": {"robot", "ids", "motion"}, "factory": {"name", "args"}}
 _PLANNER_KEYS = {"name", "factory", "label", "params"}
 
 
@@ -474,6 +492,7 @@ def experiment_from_dict(
         seed=data.get("seed", 1),
         baseline=data.get("baseline", ""),
         hard_limit_margin=data.get("hard_limit_margin", HARD_LIMIT_MARGIN),
+        warm_up=data.get("warm_up", True),
     )
 
 
@@ -516,6 +535,7 @@ def _problems(table: Mapping[str, Any], index: int, base_dir: Path) -> list[Prob
 
 
 def _mbm_problems(table: Mapping[str, Any], where: str, base_dir: Path) -> list[ProblemSpec]:
+    from ..validity import MOTION_VALIDATORS
     from ..worlds.mbm import SCENARIOS, load_mbm
 
     source = str(table["mbm"])
@@ -540,8 +560,13 @@ def _mbm_problems(table: Mapping[str, Any], where: str, base_dir: Path) -> list[
     except ValueError as error:
         raise ExperimentError(f"{where}.mbm", str(error), table["mbm"]) from error
     ids = _ids(table.get("ids", "all"), [problem.id for problem in scenario], f"{where}.ids")
+    motion = table.get("motion", "certified")
+    if motion not in MOTION_VALIDATORS:
+        raise ExperimentError(
+            f"{where}.motion", f"must be one of {', '.join(MOTION_VALIDATORS)}, got {motion!r}", motion
+        )
     name = scenario[0].scenario if scenario else Path(source).stem
-    return _mbm_specs(name, source, ids, robot)
+    return _mbm_specs(name, source, ids, robot, motion)
 
 
 def _ids(selection: Any, available: list[int], where: str) -> list[int]:

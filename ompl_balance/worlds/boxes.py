@@ -119,6 +119,39 @@ PROBLEMS: dict[str, Problem] = {
 }
 
 
+#: Not in :data:`PROBLEMS` (``compare`` runs those): start and goal each in a pocket that opens
+#: away from the other, so every way out of a pocket leaves the ball around the other root
+#: whose radius is the start-goal distance (0.3). A goal-ball sampler without uniform
+#: samples never solves it.
+TWIN_POCKETS = Problem(
+    "twin_pockets",
+    "start and goal in pockets opening away from each other",
+    (
+        (0.22, 0.60, 0.45, 0.62),
+        (0.22, 0.38, 0.45, 0.40),
+        (0.43, 0.38, 0.45, 0.62),
+        (0.55, 0.60, 0.78, 0.62),
+        (0.55, 0.38, 0.78, 0.40),
+        (0.55, 0.38, 0.57, 0.62),
+    ),
+    (0.35, 0.5),
+    (0.65, 0.5),
+)
+
+
+def circle_setup() -> og.SimpleSetup:
+    """A one-dimensional problem: SO(2), an obstacle between 0.5 and 1.0 rad, start 0 and goal
+    1.5 rad, so the only way round leads away from the goal; a counting validity checker."""
+    space = ob.SO2StateSpace()
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    si.setStateValidityChecker(CountingValidityChecker(si, lambda state: not 0.5 <= state.value <= 1.0))
+    start, goal = space.allocState(), space.allocState()
+    start.value, goal.value = 0.0, 1.5
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
 def get_problem(name: str) -> Problem:
     """The built-in problem ``name``; ``KeyError`` naming the known ones otherwise."""
     if name not in PROBLEMS:

@@ -56,10 +56,13 @@ class MBMProblem:
     environment: Environment
     valid: bool  # the file's flag: start and a goal collision-free under VAMP's sphere model
 
-    def simple_setup(self, robot: RobotModel, checker: CollisionChecker | None = None) -> og.SimpleSetup:
+    def simple_setup(
+        self, robot: RobotModel, checker: CollisionChecker | None = None, motion: str = "certified"
+    ) -> og.SimpleSetup:
         """A ``SimpleSetup`` for this problem: ``robot``'s joint space, the package's checker
-        and motion validator (``checker``, or a new one for this environment), the start,
-        and every goal as ``ob.GoalStates`` (any goal is a success).
+        (``checker``, or a new one for this environment) and its ``motion`` validator
+        (``"certified"`` or ``"discrete"``, see :func:`~ompl_balance.validity.setup_robot`),
+        the start, and every goal as ``ob.GoalStates`` (any goal is a success).
 
         ``ValueError`` when ``robot`` has another number of joints than the problem's
         configurations (load the problems with ``load_mbm(scenario, robot.joint_names)``:
@@ -72,7 +75,7 @@ class MBMProblem:
                 "problems with load_mbm(scenario, robot.joint_names) for the robot they were made for"
             )
         ss = og.SimpleSetup(space_for(robot))
-        setup_robot(ss, checker or CollisionChecker(robot, self.environment))
+        setup_robot(ss, checker or CollisionChecker(robot, self.environment), motion=motion)
         si = ss.getSpaceInformation()
         start = si.allocState()
         for i, value in enumerate(self.start):
@@ -170,11 +173,11 @@ def _scenario(source: str, robot_dir: str) -> dict[int, MBMProblem]:
     return {problem.id: problem for problem in load_mbm(source, _robot(robot_dir).joint_names)}
 
 
-def problem_setup(source: str, problem_id: int, robot_dir: str = "") -> og.SimpleSetup:
+def problem_setup(source: str, problem_id: int, robot_dir: str = "", motion: str = "certified") -> og.SimpleSetup:
     """The ``SimpleSetup`` of problem ``problem_id`` of scenario ``source`` (a shipped name or a
-    file) for the robot in ``robot_dir`` (``""``: the shipped Panda). Robot and scenario are read
-    once per process."""
-    return _scenario(source, robot_dir)[problem_id].simple_setup(_robot(robot_dir))
+    file) for the robot in ``robot_dir`` (``""``: the shipped Panda), with the ``motion``
+    validator. Robot and scenario are read once per process."""
+    return _scenario(source, robot_dir)[problem_id].simple_setup(_robot(robot_dir), motion=motion)
 
 
 def load_shipped_data() -> None:
