@@ -9,6 +9,7 @@ specs, what C++ callers see, and no start-up cost inside the first solve.
 from __future__ import annotations
 
 import math
+import os
 import re
 import shutil
 import subprocess
@@ -30,7 +31,10 @@ from ompl_balance.worlds.boxes import Problem, get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
 
-OMPL_PYTESTS = Path(__file__).resolve().parents[2] / "shared" / "data" / "ompl_pytests"
+#: OMPL 2.0.1's ``tests/pytests/`` folder: ``$OMPL_PYTESTS`` if set, else beside the repository.
+OMPL_PYTESTS = Path(
+    os.environ.get("OMPL_PYTESTS") or Path(__file__).resolve().parents[2] / "shared" / "data" / "ompl_pytests"
+)
 
 SWAP = """\
 import ompl.geometric as og
