@@ -8,6 +8,7 @@ import shutil
 import sqlite3
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -23,6 +24,7 @@ from ompl_balance.bench.experiment import (
     run_seed,
 )
 from ompl_balance.bench.logs import write_logs
+from ompl_balance.bench.progress import ProgressSampler
 from ompl_balance.bench.runner import run_isolated
 from ompl_balance.bench.summary import summarize
 from ompl_balance.cli import main
@@ -214,6 +216,36 @@ def test_the_warm_up_solve_is_neither_timed_nor_counted(tiny_sweep):
     warm, cold = run_isolated(task), run_isolated(dataclasses.replace(task, warm_up=False))
     for name in ("validity checks INTEGER", "motion checks INTEGER", "iterations INTEGER", "solution length REAL"):
         assert warm["properties"][name] == cold["properties"][name], name
+
+
+def test_progress_sampling_starts_at_begin_so_its_thread_start_is_not_timed():
+    """The sampler's thread runs from the ``with`` block's start but takes no sample before
+    ``begin()`` (the runner's clock start), and its sample times count from ``begin()``."""
+    period = 0.01
+    reads = []
+    sampler = ProgressSampler({"iterations INTEGER": lambda: str(len(reads.append(0) or reads))}, period=period)
+    with sampler:
+        assert sampler._thread.is_alive()
+        time.sleep(5 * period)
+        assert sampler.samples == [] and reads == []  # waiting for begin()
+        began = sampler.begin()
+        deadline = time.perf_counter() + 30.0
+        while len(sampler.samples) < 2 and time.perf_counter() < deadline:
+            time.sleep(period)
+        ended = time.perf_counter()
+    assert not sampler._thread.is_alive()
+    assert sampler.names == ["iterations INTEGER", "time REAL"]
+    times = [float(sample[1]) for sample in sampler.samples]
+    assert len(times) >= 2
+    assert period <= times[0] and times == sorted(times) and times[-1] <= ended - began
+    assert [int(sample[0]) for sample in sampler.samples] == list(range(1, len(times) + 1))
+
+
+def test_a_sampler_never_begun_ends_with_its_block():
+    sampler = ProgressSampler({"iterations INTEGER": lambda: "0"}, period=0.01)
+    with sampler:
+        pass
+    assert not sampler._thread.is_alive() and sampler.samples == []
 
 
 def test_rerun_runs_nothing_and_more_runs_add_only_the_missing(tmp_path):
