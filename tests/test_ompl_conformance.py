@@ -204,27 +204,33 @@ def test_approx_goal_distance_is_stocks_on_an_impossible_problem():
 
 
 def test_cpp_callers_get_ompls_methods_and_python_callers_the_packages():
+    """SimpleSetup and Benchmark (C++ callers of getPlannerData, printProperties and
+    printSettings) run every planner of the package without aborting the process."""
     script = textwrap.dedent(
         """
         from ompl import base as ob, tools as ot, util as ou
         ou.setLogLevel(ou.LOG_ERROR)
         import ompl_balance
-        ss = ompl_balance.get_problem("narrow_gap").setup()
-        planner = ompl_balance.BalancedRRTConnect(ss.getSpaceInformation())
-        ss.setPlanner(planner)
-        ss.solve(10.0)
-        data = ob.PlannerData(ss.getSpaceInformation())
-        ss.getPlannerData(data)  # C++ calls getPlannerData: OMPL's, empty
-        mine = ob.PlannerData(ss.getSpaceInformation())
-        planner.getPlannerData(mine)
-        benchmark = ot.Benchmark(ss, "cpp callers")
-        benchmark.addPlanner(planner)
-        benchmark.benchmark(ot.Request(1.0, 1024.0, 1, 0.05, False, False, False))
-        run = benchmark.getRecordedExperimentData().planners[0].runs[0].to_dict()
-        print(data.numVertices(), mine.numVertices() > 0, run["graph states INTEGER"], run["solved BOOLEAN"])
+        classes = [ompl_balance.BallRadiusRRTstar] + [getattr(ompl_balance, name) for name in ompl_balance.PRESETS]
+        for planner_class in classes:
+            ss = ompl_balance.get_problem("narrow_gap").setup()
+            planner = planner_class(ss.getSpaceInformation())
+            ss.setPlanner(planner)
+            ss.solve(10.0)
+            data = ob.PlannerData(ss.getSpaceInformation())
+            ss.getPlannerData(data)  # C++ calls getPlannerData: OMPL's, empty
+            mine = ob.PlannerData(ss.getSpaceInformation())
+            ss.getPlanner().getPlannerData(mine)  # as OMPL's test_planner_data.py calls it
+            benchmark = ot.Benchmark(ss, "cpp callers")
+            benchmark.addPlanner(planner)
+            benchmark.benchmark(ot.Request(1.0, 1024.0, 1, 0.05, False, False, False))
+            run = benchmark.getRecordedExperimentData().planners[0].runs[0].to_dict()
+            print(data.numVertices(), mine.numVertices() > 0, run["graph states INTEGER"], run["solved BOOLEAN"])
         """
     )
-    assert run_with_seed(script, 0).split() == ["0", "True", "0", "1"]
+    lines = run_with_seed(script, 0).splitlines()
+    assert len(lines) == 1 + len(PRESETS)  # every planner ran to the end: none aborted the process
+    assert all(line.split() == ["0", "True", "0", "1"] for line in lines), lines
 
 
 def test_specs_and_printouts_read_as_stocks():
