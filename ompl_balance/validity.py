@@ -64,7 +64,34 @@ class StateValidityChecker(ob.StateValidityChecker):
         self.checker.reset_counters()
 
 
-class MotionValidator(ob.MotionValidator):
+class _RobotMotionValidator(ob.MotionValidator):
+    """What the package's two motion validators share: the checker, its counters, and
+    ``last_valid`` as OMPL's ``checkMotion(s1, s2, lastValid)`` sets it."""
+
+    def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker):
+        _check_dimension(si, checker)
+        super().__init__(si)
+        self.checker = checker
+        self._dof = checker.robot.dof
+
+    def counters(self) -> dict[str, int]:
+        return self.checker.counters()
+
+    def reset_counters(self) -> None:
+        self.checker.reset_counters()
+
+    @staticmethod
+    def _set_last_valid(last_valid: ob.State | None, a: np.ndarray, b: np.ndarray, fraction: float) -> None:
+        """Set ``last_valid`` (if given) to the state at ``fraction`` of the edge ``a -> b``:
+        ``a`` itself at 0, so that a non-finite ``b`` never leaks into it."""
+        if last_valid is None:
+            return
+        values = a if fraction == 0.0 else a + fraction * (b - a)
+        for i, value in enumerate(values.tolist()):
+            last_valid[i] = value
+
+
+class MotionValidator(_RobotMotionValidator):
     """OMPL motion validator checking a whole edge in one batch.
 
     The edge ``s1 -> s2`` is cut into ``space.validSegmentCount(s1, s2)`` segments as
@@ -77,11 +104,8 @@ class MotionValidator(ob.MotionValidator):
     """
 
     def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker):
-        _check_dimension(si, checker)
-        super().__init__(si)
-        self.checker = checker
+        super().__init__(si, checker)
         self._space = si.getStateSpace()
-        self._dof = checker.robot.dof
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         return self.check_motion_last_valid(s1, s2)[0]
@@ -96,20 +120,24 @@ class MotionValidator(ob.MotionValidator):
         ``s1``, ``t = (j - 1) / nd`` for the first invalid state ``j``, and ``last_valid``
         (if given) is set to the state at ``t``. ``t = 1`` for a valid edge, and whenever
         ``last_valid`` is not given (then the states are visited coarse to fine instead).
-        A state with a non-finite value makes the edge invalid with ``t = 0``.
+        A state with a non-finite value makes the edge invalid with ``t = 0`` (``last_valid``
+        is then ``s1``).
         """
         self.checker.counter.motions_checked += 1
         values = s2[0 : self._dof]
-        if not math.isfinite(sum(values)):
-            return False, 0.0  # invalid, not an exception through OMPL's C++ caller
         b = np.array(values)
+        if not math.isfinite(sum(values)):
+            # invalid, not an exception through OMPL's C++ caller
+            self._set_last_valid(last_valid, np.array(s1[0 : self._dof]), b, 0.0)
+            return False, 0.0
         if last_valid is None and not self.checker.is_valid(b):
             # s2 alone on the single-state path first: it decides most colliding edges
             return False, 1.0
         values = s1[0 : self._dof]
-        if not math.isfinite(sum(values)):
-            return False, 0.0
         a = np.array(values)
+        if not math.isfinite(sum(values)):
+            self._set_last_valid(last_valid, a, b, 0.0)
+            return False, 0.0
         nd = self._space.validSegmentCount(s1, s2)
         t = np.arange(1, nd + 1) / nd
         if last_valid is None:
@@ -120,15 +148,8 @@ class MotionValidator(ob.MotionValidator):
         if first < 0:
             return True, 1.0
         fraction = first / nd
-        for i, value in enumerate(a + fraction * (b - a)):
-            last_valid[i] = float(value)
+        self._set_last_valid(last_valid, a, b, fraction)
         return False, fraction
-
-    def counters(self) -> dict[str, int]:
-        return self.checker.counters()
-
-    def reset_counters(self) -> None:
-        self.checker.reset_counters()
 
 
 @functools.lru_cache(maxsize=4096)
@@ -151,7 +172,7 @@ def coarse_to_fine(nd: int) -> tuple[int, ...]:
     return tuple(order)
 
 
-class CertifiedMotionValidator(ob.MotionValidator):
+class CertifiedMotionValidator(_RobotMotionValidator):
     """OMPL motion validator that proves each edge free of collision, or rejects it.
 
     An edge ``s1 -> s2`` is valid when the whole straight line ``s1 + t (s2 - s1)``,
@@ -174,11 +195,8 @@ class CertifiedMotionValidator(ob.MotionValidator):
     """
 
     def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker, clearance: float = 0.0):
-        _check_dimension(si, checker)
-        super().__init__(si)
-        self.checker = checker
+        super().__init__(si, checker)
         self.certifier = MotionCertifier(checker, clearance)
-        self._dof = checker.robot.dof
 
     @property
     def clearance(self) -> float:
@@ -200,16 +218,9 @@ class CertifiedMotionValidator(ob.MotionValidator):
         """
         a, b = np.array(s1[0 : self._dof]), np.array(s2[0 : self._dof])
         valid, fraction = self.certifier.check(a, b, last_valid=last_valid is not None)
-        if last_valid is not None and not valid:
-            for i, value in enumerate(a + fraction * (b - a) if np.isfinite(a).all() else a):
-                last_valid[i] = float(value)
+        if not valid:
+            self._set_last_valid(last_valid, a, b, fraction)
         return valid, fraction
-
-    def counters(self) -> dict[str, int]:
-        return self.checker.counters()
-
-    def reset_counters(self) -> None:
-        self.checker.reset_counters()
 
 
 def _check_dimension(si: ob.SpaceInformation, checker: CollisionChecker) -> None:

@@ -389,10 +389,14 @@ def test_bad_input_is_invalid_not_an_exception():
     bad[1] = float("nan")
     assert not si.checkMotion(good, bad) and not si.checkMotion(bad, good)
     assert validator.check_motion_last_valid(good, bad, last) == (False, 0.0)
+    assert [last[i] for i in range(3)] == [0.0, 0.0, 0.1]  # s1: nothing of the edge is certified
+    bad[1] = float("inf")
+    assert validator.check_motion_last_valid(good, bad, last) == (False, 0.0)
+    assert [last[i] for i in range(3)] == [0.0, 0.0, 0.1]
     bad[1] = 0.0
     bad[2] = 0.5  # the slide's range is [0, 0.2]
     assert not si.checkMotion(good, bad)
-    assert checker.counters()["motions_checked"] == 4
+    assert checker.counters()["motions_checked"] == 5
 
 
 def test_setup_robot_motion_names():

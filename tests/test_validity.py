@@ -253,6 +253,12 @@ def test_bad_input():
     good = si.allocState()
     good[0], good[1], good[2] = 0.0, 0.0, 0.0
     assert discrete.check_motion_last_valid(good, state) == (False, 0.0)  # NaN: invalid, no exception
+    last = si.allocState()
+    for end in (float("nan"), float("inf")):
+        state[1] = end
+        last[0], last[1], last[2] = 9.0, 9.0, 9.0
+        assert discrete.check_motion_last_valid(good, state, last) == (False, 0.0)
+        assert [last[i] for i in range(3)] == [0.0, 0.0, 0.0]  # s1, not the stale or non-finite values
 
 
 def test_warm_up_compiles_the_kernels_real_checkers_use():
