@@ -58,11 +58,7 @@ def dense_collisions(reference: CollisionChecker, states: np.ndarray, step: floa
 def solve(robot, problem: MBMProblem, planner: str, motion: str, time_limit: float, step: float) -> dict:
     """One planning run and the dense re-check of its path."""
     checker = CollisionChecker(robot, problem.environment)
-    ss = problem.simple_setup(robot, checker)
-    if motion == "discrete":  # simple_setup installs the default (certified) validator
-        from ompl_balance.validity import setup_robot
-
-        setup_robot(ss, checker, motion="discrete")
+    ss = problem.simple_setup(robot, checker, motion=motion)
     ss.setPlanner(PLANNERS[planner](ss.getSpaceInformation()))
     run = measured_solve(ss, time_limit)
     colliding = None

@@ -25,18 +25,16 @@ from ompl import util as ou
 from ompl_balance import BalancedRRTConnect
 from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.core.counting import measured_solve
-from ompl_balance.validity import MOTION_VALIDATORS, CollisionChecker, setup_robot
-from ompl_balance.worlds.mbm import load_mbm
+from ompl_balance.validity import MOTION_VALIDATORS, CollisionChecker
+from ompl_balance.worlds.mbm import SCENARIOS, load_mbm
 
-SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small")
 PLANNERS = {"RRTConnect": og.RRTConnect, "BalancedRRTConnect": BalancedRRTConnect}
 
 
 def solve(robot, problem, make_planner, time_limit: float, motion: str) -> dict:
     """One planning run; returns success, seconds, work counts and whether the path re-checks valid."""
     checker = CollisionChecker(robot, problem.environment)
-    ss = problem.simple_setup(robot, checker)
-    setup_robot(ss, checker, motion=motion)
+    ss = problem.simple_setup(robot, checker, motion=motion)
     ss.setPlanner(make_planner(ss.getSpaceInformation()))
     run = measured_solve(ss, time_limit)
     path_valid = None

@@ -257,6 +257,15 @@ def test_parameter_names_of_stock_planners_are_checked_before_any_run():
             runs=1,
             time_limit=1.0,
         )
+    # a parameter OMPL declares whose setter the bindings lack fails here, not in every run
+    with pytest.raises(ExperimentError, match=r"planners\[0\].params.balanced: .*do not bind setExploration"):
+        Experiment(
+            name="unbound",
+            problems=(ProblemSpec("open", "builtin", "open"),),
+            planners=(PlannerSpec("BFMT", "BFMT", params={"balanced": "1"}),),
+            runs=1,
+            time_limit=1.0,
+        )
 
 
 def test_a_run_reaching_its_memory_limit_stops_as_ompl_stops_it(tmp_path):

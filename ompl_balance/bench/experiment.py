@@ -48,6 +48,7 @@ keys, planners or parameters, missing files, bad ids and non-positive numbers ra
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib
 import json
@@ -272,8 +273,10 @@ def run_seed(experiment_seed: int, problem: str, planner: str, run: int) -> int:
     return 1 + int.from_bytes(digest, "little") % (2**31 - 2)
 
 
+@functools.cache
 def versions() -> dict[str, str]:
-    """The versions of this package and of OMPL's Python package that runs execute with."""
+    """The versions of this package and of OMPL's Python package that runs execute with (read
+    once per process: every cell's definition carries them)."""
     return {"ompl-balance": metadata.version("ompl-balance"), "ompl": metadata.version("ompl")}
 
 

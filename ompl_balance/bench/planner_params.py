@@ -23,6 +23,7 @@ import re
 from typing import Any
 
 from ompl import base as ob
+from ompl import geometric as og
 
 #: Stock planner class -> declared parameter name -> (C++ type, setter, getter). A value is logged
 #: empty where the bindings lack the getter (BFMT's ``balanced`` and ``optimality``).
@@ -225,10 +226,7 @@ def set_planner_param(planner: ob.Planner, name: str, value: str) -> None:
         if not params.setParam(name, value):
             raise ValueError(f"bad value {value!r} for {name!r}; accepted: {params.getRangeSuggestion(name)}")
         return
-    stock = _stock_params(planner)
-    setter, converted = _stock_value(planner.getName(), stock, name, value)
-    if not hasattr(planner, setter):
-        raise ValueError(f"{name!r} cannot be set from Python: OMPL's bindings do not bind {setter}")
+    setter, converted = _stock_value(type(planner), _stock_params(planner), name, value)
     try:
         getattr(planner, setter)(converted)
     except (TypeError, ValueError) as error:
@@ -238,16 +236,21 @@ def set_planner_param(planner: ob.Planner, name: str, value: str) -> None:
 def check_declared_param(planner_class: str, name: str, value: str) -> None:
     """:func:`set_planner_param`'s checks for a stock planner of :data:`DECLARED_PARAMS`, without
     building one (some stock planners crash the process when destroyed: OMPL 2.0.1's AORRTC)."""
-    _stock_value(planner_class, DECLARED_PARAMS[planner_class], name, value)
+    _stock_value(getattr(og, planner_class), DECLARED_PARAMS[planner_class], name, value)
 
 
 def _stock_value(
-    planner: str, params: dict[str, tuple[str, str, str]], name: str, value: str
+    planner_class: type, params: dict[str, tuple[str, str, str]], name: str, value: str
 ) -> tuple[str, bool | int | float]:
-    """The setter of stock parameter ``name`` and ``value`` converted to its type; ``ValueError``."""
+    """The setter of stock parameter ``name`` (bound on ``planner_class``) and ``value`` converted
+    to its type; ``ValueError``."""
     if name not in params:
-        raise ValueError(f"unknown parameter {name!r}; {planner} has {', '.join(sorted(params)) or 'none'}")
+        raise ValueError(
+            f"unknown parameter {name!r}; {planner_class.__name__} has {', '.join(sorted(params)) or 'none'}"
+        )
     kind, setter, _getter = params[name]
+    if not hasattr(planner_class, setter):
+        raise ValueError(f"{name!r} cannot be set from Python: OMPL's bindings do not bind {setter}")
     try:
         return setter, _from_text(kind, value)
     except ValueError as error:
