@@ -321,6 +321,17 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
     points, start_tree, goal_tree = context.points, context.start_tree, context.goal_tree
     uniform, distance, random, counts = points.sample, points.distance, context.random, context.counts
     uniform_rate = context.uniform_rate
+
+    def or_uniform(sampler: TargetSampler) -> TargetSampler:
+        """``sampler``, except that an iteration targets a uniform sample with probability ``uniform_rate``."""
+        if uniform_rate <= 0.0:
+            return sampler
+
+        def mixed(grow_start: bool) -> tuple[Any, int | None]:
+            return (uniform(), None) if random() < uniform_rate else sampler(grow_start)
+
+        return mixed
+
     if sample_policy == "uniform":
         return lambda grow_start: (uniform(), None)
     if sample_policy == "goal_bias":
@@ -335,8 +346,6 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
     if sample_policy == "goal_ball":
 
         def in_goal_ball(grow_start: bool) -> tuple[Any, int | None]:
-            if uniform_rate > 0.0 and random() < uniform_rate:
-                return uniform(), None
             centre = (goal_tree if grow_start else start_tree).state(0)
             radius = distance(start_tree.state(0), goal_tree.state(0))
             for _ in range(SAMPLE_ATTEMPTS):
@@ -346,14 +355,12 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
                 counts.rejections += 1
             return None, None
 
-        return in_goal_ball
+        return or_uniform(in_goal_ball)
     if sample_policy == "neighbour_quality":
         costs = {start_tree: NodeCosts(distance), goal_tree: NodeCosts(distance)}
         min_quality, find_nearest = context.min_quality, context.find_nearest
 
         def quality_accepted(grow_start: bool) -> tuple[Any, int | None]:
-            if uniform_rate > 0.0 and random() < uniform_rate:
-                return uniform(), None
             tree = start_tree if grow_start else goal_tree
             start, goal = start_tree.state(0), goal_tree.state(0)
             tree_costs = costs[tree]
@@ -367,15 +374,13 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
                 counts.rejections += 1
             return None, None
 
-        return quality_accepted
+        return or_uniform(quality_accepted)
     if sample_policy == "valid_sampler":
         sampler, checker, state = context.valid_sampler, context.checker, context.scratch
         if sampler is None or checker is None or state is None:
             raise ValueError("sample_policy valid_sampler needs a valid-state sampler, the checker and a scratch state")
 
         def from_valid_sampler(grow_start: bool) -> tuple[Any, int | None]:
-            if uniform_rate > 0.0 and random() < uniform_rate:
-                return uniform(), None
             before = checker.counters()["states_checked"]
             found = sampler.sample(state)
             counts.checks += checker.counters()["states_checked"] - before
@@ -386,5 +391,5 @@ def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
                 return uniform(), None
             return points.from_state(state), None
 
-        return from_valid_sampler
+        return or_uniform(from_valid_sampler)
     raise ValueError(f"unknown sample_policy {sample_policy!r}; accepted: {', '.join(SAMPLE_POLICIES)}")

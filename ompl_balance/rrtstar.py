@@ -426,7 +426,8 @@ class BallRadiusRRTstar(TreePlanner):
             # Parent: the neighbour giving the cheapest valid path.
             neighbours, distances = self._neighbours(tree, new, d, gamma)
             costs = nodes.costs
-            through = costs[neighbours] + distances
+            neighbour_costs = costs[neighbours]  # adding the new node below changes none of them
+            through = neighbour_costs + distances
             parent, cost = nearest, costs[nearest] + min(distance, eta)
             valid = {nearest: True}  # neighbour -> whether its motion to the new state is valid
             # Delayed: candidates in order of cost, up to the first valid one. Not delayed (as
@@ -450,7 +451,7 @@ class BallRadiusRRTstar(TreePlanner):
             # Rewire: neighbours reached more cheaply through the new state.
             costs = nodes.costs
             rewired = False
-            for i in np.flatnonzero(cost + distances < costs[neighbours]).tolist():
+            for i in np.flatnonzero(cost + distances < neighbour_costs).tolist():
                 neighbour, through_new = int(neighbours[i]), cost + distances[i]
                 if not through_new < costs[neighbour]:
                     continue  # an earlier rewire in this loop made it cheaper already
