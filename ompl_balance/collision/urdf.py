@@ -70,6 +70,16 @@ class _Problems:
     def fail(self, node: _Node, message: str) -> NoReturn:
         raise ValueError(f"URDF {self.path}, line {node.line}: {message}")
 
+    def register(self, named: dict[str, _Node], node: _Node) -> str:
+        """Add ``node`` (a <link> or <joint>) to ``named`` under its name; returns the name."""
+        name = node.attributes.get("name")
+        if not name:
+            self.fail(node, f"<{node.tag}> has no 'name' attribute")
+        if name in named:
+            self.fail(node, f"{node.tag} {name!r} is defined twice (first on line {named[name].line})")
+        named[name] = node
+        return name
+
     def numbers(self, owner: str, node: _Node, attribute: str, count: int, required: bool = True) -> list[float] | None:
         """The ``count`` numbers of ``node``'s ``attribute`` (``owner``: the link or joint, for
         messages); ``None`` when absent and not required."""
@@ -102,12 +112,7 @@ def check_urdf(path: str | Path) -> None:
         problems.fail(robot, "<robot> has no 'name' attribute")
     links: dict[str, _Node] = {}
     for link in (c for c in robot.children if c.tag == "link"):
-        name = link.attributes.get("name")
-        if not name:
-            problems.fail(link, "<link> has no 'name' attribute")
-        elif name in links:
-            problems.fail(link, f"link {name!r} is defined twice (first on line {links[name].line})")
-        links[name] = link
+        problems.register(links, link)
         for collision in (c for c in link.children if c.tag == "collision"):
             _check_collision(problems, link, collision)
     if not links:
@@ -115,12 +120,7 @@ def check_urdf(path: str | Path) -> None:
     joints: dict[str, _Node] = {}
     parent_of: dict[str, str] = {}
     for joint in (c for c in robot.children if c.tag == "joint"):
-        name = joint.attributes.get("name")
-        if not name:
-            problems.fail(joint, "<joint> has no 'name' attribute")
-        elif name in joints:
-            problems.fail(joint, f"joint {name!r} is defined twice (first on line {joints[name].line})")
-        joints[name] = joint
+        name = problems.register(joints, joint)
         kind = joint.attributes.get("type")
         if kind not in JOINT_TYPES:
             problems.fail(joint, f"{joint.describe()} has type {kind!r}; supported: {', '.join(JOINT_TYPES)}")
