@@ -16,9 +16,9 @@ Run: ``python benchmarks/bench_mbm_rrtc.py [--problems 10] [--time-limit 10] [--
 from __future__ import annotations
 
 import argparse
-import statistics
 
 import numpy as np
+from cells import medians, ratios, success
 from ompl import geometric as og
 from ompl import util as ou
 
@@ -83,17 +83,12 @@ def main() -> None:
                 if result["path_valid"] is False:
                     raise AssertionError(f"{scenario} problem {problem.id}: {name} returned a path in collision")
                 results[name].append(result)
-        medians = {
-            name: {key: statistics.median(r[key] for r in runs) for key in ("time", "checks", "motions")}
-            for name, runs in results.items()
-        }
-        stock = medians["RRTConnect"]
+        cell = medians(results, ("time", "checks", "motions"))
         for name, runs in results.items():
-            m = medians[name]
-            success = sum(r["solved"] for r in runs) / len(runs)
+            m, ratio = cell[name], ratios(cell[name], cell["RRTConnect"])
             print(
-                f"| {scenario} | {name} | {success:.0%} | {m['time'] * 1e3:.0f} | {m['checks']:.0f} | {m['motions']:.0f} "
-                f"| {m['time'] / stock['time']:.2f} | {m['checks'] / max(stock['checks'], 1):.2f} |",
+                f"| {scenario} | {name} | {success(runs):.0%} | {m['time'] * 1e3:.0f} | {m['checks']:.0f} "
+                f"| {m['motions']:.0f} | {ratio['time']:.2f} | {ratio['checks']:.2f} |",
                 flush=True,
             )
 

@@ -37,6 +37,7 @@ import subprocess
 import sys
 import time
 
+from cells import medians, ratios, success
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
@@ -206,21 +207,15 @@ def main() -> None:
         for _ in range(args.runs):
             for name, make_planner in PLANNERS.items():
                 results[name].append(run(PROBLEMS[problem], make_planner, args.time_limit))
-        medians = {
-            name: {key: statistics.median(r[key] for r in runs) for key in ("time", "checks", "motions")}
-            for name, runs in results.items()
-        }
-        per_motion = {
-            name: statistics.median(r["time"] / max(r["motions"], 1) for r in runs) for name, runs in results.items()
-        }
-        stock = medians["RRTConnect"]
+        for runs in results.values():
+            for r in runs:
+                r["time per motion"] = r["time"] / max(r["motions"], 1)
+        cell = medians(results, ("time", "checks", "motions", "time per motion"))
         for name, runs in results.items():
-            m = medians[name]
-            success = sum(r["solved"] for r in runs) / len(runs)
+            m, ratio = cell[name], ratios(cell[name], cell["RRTConnect"])
             print(
-                f"| {problem} | {name} | {success:.0%} | {m['time'] * 1e3:.1f} | {m['checks']:.0f} | {m['motions']:.0f} "
-                f"| {m['time'] / stock['time']:.2f} | {m['checks'] / stock['checks']:.2f} "
-                f"| {per_motion[name] / per_motion['RRTConnect']:.2f} |",
+                f"| {problem} | {name} | {success(runs):.0%} | {m['time'] * 1e3:.1f} | {m['checks']:.0f} "
+                f"| {m['motions']:.0f} | {ratio['time']:.2f} | {ratio['checks']:.2f} | {ratio['time per motion']:.2f} |",
                 flush=True,
             )
 

@@ -25,10 +25,9 @@ Run: python benchmarks/bench_variants.py [--runs 20] [--time-limit 10] [--mbm 0]
 from __future__ import annotations
 
 import argparse
-import math
-import statistics
 from collections.abc import Callable
 
+from cells import medians, ratios, success
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
@@ -163,19 +162,13 @@ def main() -> None:
         for _ in range(args.runs):
             for name, make_planner in planners.items():
                 results[name].append(run(make_setup, make_planner, args.time_limit))
-        medians = {
-            name: {key: statistics.median(r[key] for r in runs) for key in ("time", "queries", "nodes")}
-            for name, runs in results.items()
-        }
-        stock = medians["RRTConnect"]
+        cell = medians(results, ("time", "queries", "nodes"))
         for name, runs in results.items():
-            m = medians[name]
-            success = sum(r["solved"] for r in runs) / len(runs)
-            ratios = {key: m[key] / stock[key] if stock[key] else math.nan for key in m}
-            query_ratios[name][problem] = ratios["queries"]
+            m, ratio = cell[name], ratios(cell[name], cell["RRTConnect"])
+            query_ratios[name][problem] = ratio["queries"]
             print(
-                f"| {problem} | {name} | {success:.0%} | {m['time'] * 1e3:.1f} | {m['queries']:.0f} | {m['nodes']:.0f} "
-                f"| {ratios['time']:.2f} | {ratios['queries']:.2f} | {ratios['nodes']:.2f} |",
+                f"| {problem} | {name} | {success(runs):.0%} | {m['time'] * 1e3:.1f} | {m['queries']:.0f} "
+                f"| {m['nodes']:.0f} | {ratio['time']:.2f} | {ratio['queries']:.2f} | {ratio['nodes']:.2f} |",
                 flush=True,
             )
 
