@@ -93,20 +93,26 @@ class ProgressSampler:
     times; sample times count from :meth:`begin`. ``names`` are ``"time REAL"`` and the
     property names, sorted (the order of OMPL's log); ``samples`` one list of values per
     sample in that order. A property whose function raises is recorded empty for that sample.
+
+    ``check``, if given, is called by the same thread before each sample: the run's memory
+    limit, which OMPL's ``Benchmark`` also evaluates periodically in a thread of its own.
     """
 
-    def __init__(self, properties: ProgressProperties, period: float = SAMPLE_PERIOD) -> None:
+    def __init__(
+        self, properties: ProgressProperties, period: float = SAMPLE_PERIOD, check: Callable[[], None] | None = None
+    ) -> None:
         self.period = period
         self.names = sorted(["time REAL", *properties])
         self.samples: list[list[str]] = []
         self._properties = properties
+        self._check = check
         self._began_event = threading.Event()
         self._done = threading.Event()
         self._thread = threading.Thread(target=self._sample, name="progress sampler", daemon=True)
         self._began = 0.0
 
     def __enter__(self) -> ProgressSampler:
-        if self._properties:
+        if self._properties or self._check is not None:
             self._thread.start()
         return self
 
@@ -127,6 +133,10 @@ class ProgressSampler:
     def _sample(self) -> None:
         self._began_event.wait()
         while not self._done.wait(self.period):
+            if self._check is not None:
+                self._check()
+            if not self._properties:
+                continue
             values = {"time REAL": repr(time.perf_counter() - self._began)}
             for name, read in self._properties.items():
                 try:

@@ -45,7 +45,7 @@ from ompl import util as ou
 from ..core.counting import read_work
 from .experiment import Experiment, MissingExtraError, RunTask
 from .planner_params import named_by_getters, planner_params
-from .progress import SAMPLE_PERIOD, ProgressSampler, progress_properties
+from .progress import ProgressSampler, progress_properties
 
 #: OMPL's planner status names -> the index the OMPL log's ``status`` enum uses.
 STATUS_INDEX = {
@@ -96,39 +96,40 @@ def _peak_memory() -> float:
 
 class MemoryLimit:
     """OMPL's memory limit: ends the solve through its termination condition once the process's
-    peak resident memory has grown by ``limit`` MB since the ``with`` block began (checked
-    every 0.05 s, as ``Benchmark``'s condition checks ``getProcessMemoryUsage``); the planner
-    then returns what it has, as under a time limit. ``limit <= 0``: no limit.
+    peak resident memory has grown by ``limit`` MB since the ``with`` block began; the planner
+    then returns what it has, as under a time limit. :meth:`check` decides, called every 0.05 s
+    by the run's sampling thread (as ``Benchmark``'s condition checks ``getProcessMemoryUsage``
+    periodically). ``limit <= 0``: no limit.
 
     Behind it, for a planner that ignores its termination condition, the process's address
     space may grow by at most 2 x ``limit`` + :data:`ADDRESS_SPACE_MARGIN` MB (Linux only):
     past that an allocation fails and the run is recorded as ``CRASH``.
     """
 
-    def __init__(self, limit: float, ptc: ob.PlannerTerminationCondition) -> None:
-        self.limit, self.ptc, self.reached = limit, ptc, False
-        self._done = threading.Event()
-        self._thread = threading.Thread(target=self._watch, name="memory limit", daemon=True)
+    def __init__(self, limit: float) -> None:
+        self.limit, self.reached = limit, False
+        self.ptc: ob.PlannerTerminationCondition | None = None  # the solve's, set by watch()
         self.start = 0.0  # MB, peak resident memory when the block began
+
+    def watch(self, ptc: ob.PlannerTerminationCondition) -> MemoryLimit:
+        """This limit as the ``with`` block of the solve that ``ptc`` ends."""
+        self.ptc = ptc
+        return self
 
     def __enter__(self) -> MemoryLimit:
         self.start = _peak_memory()
         if self.limit > 0:
-            self._thread.start()
             _limit_address_space(2 * self.limit + ADDRESS_SPACE_MARGIN)
         return self
 
     def __exit__(self, *exc_info: object) -> None:
-        self._done.set()
-        if self._thread.is_alive():
-            self._thread.join()
+        self.ptc = None
 
-    def _watch(self) -> None:
-        while not self._done.wait(SAMPLE_PERIOD):
-            if _peak_memory() - self.start > self.limit:
-                self.reached = True
-                self.ptc.terminate()
-                return
+    def check(self) -> None:
+        """End the solve if its memory has grown past the limit."""
+        if self.ptc is not None and not self.reached and _peak_memory() - self.start > self.limit:
+            self.reached = True
+            self.ptc.terminate()
 
 
 #: The run's OMPL objects, never destroyed: the process ends with ``os._exit`` after sending its
@@ -190,7 +191,8 @@ def execute(task: RunTask) -> Record:
     params = planner_params(planner)
     if run_seeded:
         params["seed"] = "run"  # each run's own seed (the run property "seed")
-    sampler = ProgressSampler(progress_properties(planner))
+    memory = MemoryLimit(task.memory_limit)
+    sampler = ProgressSampler(progress_properties(planner), check=memory.check if task.memory_limit > 0 else None)
     work_before = read_work(si)
     began = time.perf_counter()
     try:
@@ -198,7 +200,7 @@ def execute(task: RunTask) -> Record:
             warm_up(task)  # its own problem and planner: neither timed nor counted
             work_before, began = read_work(si), time.perf_counter()
         ptc = ob.timedPlannerTerminationCondition(task.time_limit)
-        with sampler, MemoryLimit(task.memory_limit, ptc) as memory:
+        with memory.watch(ptc), sampler:
             # The sampling and memory threads run already: their start and end are the
             # harness's cost, not the planner's (a Python thread's start costs as much as a
             # millisecond, a C++ one in OMPL's Benchmark microseconds), so only the solve is timed.
