@@ -530,9 +530,7 @@ class BalancedRRTConnect(TreePlanner):
         if self._start_tree is None or self._goal_tree is None:
             return
         start = self._add_tree(data, points, self._start_tree, START_TAG, keep_alive)
-        goal = self._add_tree(
-            data, points, self._goal_tree, GOAL_TAG, keep_alive, roots_are_starts=False, towards_root=True
-        )
+        goal = self._add_tree(data, points, self._goal_tree, GOAL_TAG, keep_alive, goal_tree=True)
         if self._connection is not None:
             start_node, goal_node = self._connection
             data.addEdge(start[start_node], goal[goal_node])

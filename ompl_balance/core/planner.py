@@ -321,15 +321,14 @@ class TreePlanner(ob.Planner):
         tree: Tree,
         tag: int,
         keep_alive: list[ob.State],
-        roots_are_starts: bool = True,
         goal_nodes: Sequence[int] = (),
-        towards_root: bool = False,
+        goal_tree: bool = False,
     ) -> list[int]:
         """Add ``tree``'s nodes (tagged ``tag``) and its edges; returns the vertex index of each node.
 
-        Edges run parent -> child, or child -> parent with ``towards_root`` (OMPL's goal
-        trees). Roots are start vertices (goal vertices unless ``roots_are_starts``);
-        ``goal_nodes`` are marked as goal vertices.
+        Roots are start vertices and edges run parent -> child; in a ``goal_tree`` (OMPL's
+        goal trees) roots are goal vertices and edges run child -> parent. ``goal_nodes``
+        are marked as goal vertices.
         """
         goals = set(goal_nodes)
         indices = []
@@ -338,16 +337,17 @@ class TreePlanner(ob.Planner):
             keep_alive.append(state)
             vertex = ob.PlannerDataVertex(state, tag)
             if tree.parent(node) == NO_PARENT:
-                indices.append(data.addStartVertex(vertex) if roots_are_starts else data.addGoalVertex(vertex))
+                indices.append(data.addGoalVertex(vertex) if goal_tree else data.addStartVertex(vertex))
             elif node in goals:
                 indices.append(data.addGoalVertex(vertex))
             else:
                 indices.append(data.addVertex(vertex))
-        for node in range(len(tree)):
+        for node, index in enumerate(indices):
             parent = tree.parent(node)
-            if parent != NO_PARENT:
-                if towards_root:
-                    data.addEdge(indices[node], indices[parent])
-                else:
-                    data.addEdge(indices[parent], indices[node])
+            if parent == NO_PARENT:
+                continue
+            if goal_tree:
+                data.addEdge(index, indices[parent])
+            else:
+                data.addEdge(indices[parent], index)
         return indices
