@@ -25,6 +25,27 @@ from typing import Any
 from ompl import base as ob
 from ompl import geometric as og
 
+# Parameters the KPIECE family and the FMT family share.
+_KPIECE = {
+    "border_fraction": ("double", "setBorderFraction", "getBorderFraction"),
+    "min_valid_path_fraction": ("double", "setMinValidPathFraction", "getMinValidPathFraction"),
+    "range": ("double", "setRange", "getRange"),
+}
+_FAILED_EXPANSION = {
+    "failed_expansion_score_factor": (
+        "double",
+        "setFailedExpansionCellScoreFactor",
+        "getFailedExpansionCellScoreFactor",
+    ),
+}
+_FMT = {
+    "cache_cc": ("bool", "setCacheCC", "getCacheCC"),
+    "extended_fmt": ("bool", "setExtendedFMT", "getExtendedFMT"),
+    "heuristics": ("bool", "setHeuristics", "getHeuristics"),
+    "num_samples": ("unsigned", "setNumSamples", "getNumSamples"),
+    "radius_multiplier": ("double", "setRadiusMultiplier", "getRadiusMultiplier"),
+}
+
 #: Stock planner class -> declared parameter name -> (C++ type, setter, getter). A value is logged
 #: empty where the bindings lack the getter (BFMT's ``balanced`` and ``optimality``).
 DECLARED_PARAMS: dict[str, dict[str, tuple[str, str, str]]] = {
@@ -39,32 +60,9 @@ DECLARED_PARAMS: dict[str, dict[str, tuple[str, str, str]]] = {
     },
     "PRM": {"max_nearest_neighbors": ("unsigned", "setMaxNearestNeighbors", "getMaxNearestNeighbors")},
     "PRMstar": {},  # PRMstar removes PRM's max_nearest_neighbors
-    "KPIECE1": {
-        "border_fraction": ("double", "setBorderFraction", "getBorderFraction"),
-        "failed_expansion_score_factor": (
-            "double",
-            "setFailedExpansionCellScoreFactor",
-            "getFailedExpansionCellScoreFactor",
-        ),
-        "goal_bias": ("double", "setGoalBias", "getGoalBias"),
-        "min_valid_path_fraction": ("double", "setMinValidPathFraction", "getMinValidPathFraction"),
-        "range": ("double", "setRange", "getRange"),
-    },
-    "BKPIECE1": {
-        "border_fraction": ("double", "setBorderFraction", "getBorderFraction"),
-        "failed_expansion_score_factor": (
-            "double",
-            "setFailedExpansionCellScoreFactor",
-            "getFailedExpansionCellScoreFactor",
-        ),
-        "min_valid_path_fraction": ("double", "setMinValidPathFraction", "getMinValidPathFraction"),
-        "range": ("double", "setRange", "getRange"),
-    },
-    "LBKPIECE1": {
-        "border_fraction": ("double", "setBorderFraction", "getBorderFraction"),
-        "min_valid_path_fraction": ("double", "setMinValidPathFraction", "getMinValidPathFraction"),
-        "range": ("double", "setRange", "getRange"),
-    },
+    "KPIECE1": {**_KPIECE, **_FAILED_EXPANSION, "goal_bias": ("double", "setGoalBias", "getGoalBias")},
+    "BKPIECE1": {**_KPIECE, **_FAILED_EXPANSION},
+    "LBKPIECE1": _KPIECE,
     "BITstar": {
         "delay_rewiring_to_first_solution": (
             "bool",
@@ -90,23 +88,12 @@ DECLARED_PARAMS: dict[str, dict[str, tuple[str, str, str]]] = {
         "use_k_nearest": ("bool", "setUseKNearest", "getUseKNearest"),
         "use_strict_queue_ordering": ("bool", "setStrictQueueOrdering", "getStrictQueueOrdering"),
     },
-    "FMT": {
-        "cache_cc": ("bool", "setCacheCC", "getCacheCC"),
-        "extended_fmt": ("bool", "setExtendedFMT", "getExtendedFMT"),
-        "heuristics": ("bool", "setHeuristics", "getHeuristics"),
-        "num_samples": ("unsigned", "setNumSamples", "getNumSamples"),
-        "radius_multiplier": ("double", "setRadiusMultiplier", "getRadiusMultiplier"),
-        "use_k_nearest": ("bool", "setNearestK", "getNearestK"),
-    },
+    "FMT": {**_FMT, "use_k_nearest": ("bool", "setNearestK", "getNearestK")},
     "BFMT": {
+        **_FMT,
         "balanced": ("bool", "setExploration", "getExploration"),
-        "cache_cc": ("bool", "setCacheCC", "getCacheCC"),
-        "extended_fmt": ("bool", "setExtendedFMT", "getExtendedFMT"),
-        "heuristics": ("bool", "setHeuristics", "getHeuristics"),
         "nearest_k": ("bool", "setNearestK", "getNearestK"),
-        "num_samples": ("unsigned", "setNumSamples", "getNumSamples"),
         "optimality": ("bool", "setTermination", "getTermination"),
-        "radius_multiplier": ("double", "setRadiusMultiplier", "getRadiusMultiplier"),
     },
     "AORRTC": {},
 }
