@@ -69,7 +69,7 @@ except metadata.PackageNotFoundError:  # run from a source tree that was not ins
 #: helpers whose home is a module of their own)
 _LAZY = {
     "RobotModel": "collision.kinematics",
-    "Environment": "collision.checker",
+    "Environment": "collision.environment",
     "CollisionChecker": "collision.checker",
     "load_example_robot_data_panda": "collision.robots",
     "load_panda_vamp": "collision.robots",

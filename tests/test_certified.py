@@ -20,7 +20,8 @@ from test_validity import arm3_scene
 import ompl_balance
 from ompl_balance import BalancedRRTConnect
 from ompl_balance.collision import certified
-from ompl_balance.collision.checker import CollisionChecker, Environment
+from ompl_balance.collision.checker import CollisionChecker
+from ompl_balance.collision.environment import Environment
 from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.collision.travel import travel_weights
 from ompl_balance.core.counting import read_work

@@ -10,7 +10,8 @@ import yourdfpy
 from ompl import base as ob
 from ompl import geometric as og
 
-from ompl_balance.collision.checker import CollisionChecker, Environment
+from ompl_balance.collision.checker import CollisionChecker
+from ompl_balance.collision.environment import Environment
 from ompl_balance.collision.kinematics import RobotModel
 from ompl_balance.collision.robots import PANDA_VAMP_DIR, load_panda_vamp
 from ompl_balance.core.counting import read_work

@@ -42,8 +42,8 @@ from .cache import cached_arrays
 from .geometry import fcl_transform
 from .kinematics import Chain, RobotModel, _chain_poses_batch, chain_poses
 
-if TYPE_CHECKING:  # (the checker imports this module)
-    from .checker import Obstacle
+if TYPE_CHECKING:
+    from .environment import Obstacle
 
 #: Slack (m) added to every bounding-volume test so that rounding never clears a contact.
 SLACK = 1e-6

@@ -24,7 +24,8 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..collision.checker import CollisionChecker, Environment
+from ..collision.checker import CollisionChecker
+from ..collision.environment import Environment
 from ..collision.kinematics import RobotModel
 from ..validity import setup_robot, space_for
 
