@@ -6,7 +6,8 @@ from fresh_process import run_with_seed
 from ompl import base as ob
 
 from ompl_balance.core import trees
-from ompl_balance.core.trees import COMPILED_SCANS_FROM, NO_PARENT, ArrayTree, StateTree, _squared_distances, load_scans
+from ompl_balance.core.layout import squared_distances as _squared_distances
+from ompl_balance.core.trees import COMPILED_SCANS_FROM, NO_PARENT, ArrayTree, StateTree, load_scans
 
 
 @pytest.mark.parametrize(("dim", "offset", "scale"), [(2, 0.0, 1.0), (7, 0.0, 1.0), (3, 1e6, 1e-3), (7, -50.0, 1e-6)])
@@ -61,7 +62,7 @@ def test_kernels_load_only_where_a_tree_needs_them():
         "from ompl import base as ob, util as ou\n"
         "from ompl_balance.core import trees\n"
         "ou.setLogLevel(ou.LOG_WARN)\n"
-        "loaded = lambda: ('numba' in sys.modules, 'ompl_balance.core.scans' in sys.modules)\n"
+        "loaded = lambda: ('numba' in sys.modules, 'ompl_balance.core.compiled_spaces' in sys.modules)\n"
         "print(*loaded())\n"
         "problem = ompl_balance.get_problem('narrow_gap')\n"
         "ss = problem.setup()\n"
@@ -76,7 +77,7 @@ def test_kernels_load_only_where_a_tree_needs_them():
         "    tree.add(point)\n"
         "answer = tree.nearest(np.array([0.5, 0.5]))\n"
         "trees._LOADER.finish()\n"
-        "print('ompl_balance.core.scans' in sys.modules, tree.nearest(np.array([0.5, 0.5])) == answer)\n"
+        "print('ompl_balance.core.compiled_spaces' in sys.modules, tree.nearest(np.array([0.5, 0.5])) == answer)\n"
     )
     assert run_with_seed(script, 0).split() == ["False"] * 2 + ["False"] * 2 + ["True", "False", "False"] + [
         "True",
@@ -92,11 +93,11 @@ def test_numpy_and_compiled_scans_agree_to_the_last_bit(dim):
         states = np.ascontiguousarray(rng.normal(size=(300, dim)) * scale)
         for query in rng.normal(size=(30, dim)) * scale:
             squared = _squared_distances(states, query)
-            index, nearest_squared = scans.nearest(states, len(states), query)
+            index, nearest_squared = scans.euclidean_nearest(states, len(states), query)
             assert index == int(squared.argmin()) and nearest_squared == squared[index]
             radius = float(np.sqrt(np.quantile(squared, 0.1)))
             indices, distances = np.empty(300, dtype=np.int64), np.empty(300)
-            count = scans.within(states, len(states), query, radius, indices, distances)
+            count = scans.euclidean_within(states, len(states), query, radius, indices, distances)
             inside = np.flatnonzero(squared <= radius * radius)
             assert np.array_equal(indices[:count], inside)
             assert np.array_equal(distances[:count], np.sqrt(squared[inside]))

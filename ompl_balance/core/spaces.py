@@ -3,15 +3,15 @@
 A planner works on "points" and asks this layer everything it needs to know about
 them. Two implementations share one interface:
 
-:class:`RealVectorPoints`
-    for ``ob.RealVectorStateSpace``: points are numpy arrays of shape ``(dim,)``,
-    sampled uniformly within the bounds from a numpy generator, with Euclidean
-    distance and straight-line interpolation (what OMPL's real-vector space does);
-    trees are :class:`~ompl_balance.core.trees.ArrayTree`.
+:class:`ArrayPoints`
+    for the spaces with a flat layout (:mod:`ompl_balance.core.layout`: real-vector spaces,
+    SO(2), SO(3), SE(2), SE(3) and compounds of them): points are numpy arrays of shape
+    ``(dim,)``, sampled uniformly from a numpy generator, with OMPL's metric and
+    interpolation computed on the arrays; trees are :class:`~ompl_balance.core.trees.ArrayTree`.
 :class:`StatePoints`
-    for every other OMPL space (SO2, SE2, SE3, compound, ...): points are OMPL states,
-    and every question goes to OMPL (``si.distance``, ``space.interpolate``, the
-    space's default sampler); trees are :class:`~ompl_balance.core.trees.StateTree`.
+    for every other OMPL space: points are OMPL states, and every question goes to OMPL
+    (``si.distance``, ``space.interpolate``, the space's default sampler); trees are
+    :class:`~ompl_balance.core.trees.StateTree`.
 
 Collision checking is never done here: planners pass ``ompl_state(point)`` to
 ``si.isValid`` / ``si.checkMotion`` so that stock OMPL planners and ours use exactly the
@@ -26,9 +26,12 @@ from typing import Any, Protocol
 import numpy as np
 from ompl import base as ob
 
+from . import layout as flat
+from .layout import SpaceLayout, layout_for, state_reader
 from .trees import ArrayTree, StateTree, Tree
 
-_SAMPLE_BLOCK = 256  # uniform samples drawn from numpy at a time
+#: Uniform samples drawn from numpy at a time (the compiled engine draws the same blocks).
+SAMPLE_BLOCK = 256
 _EQUAL_TOLERANCE = 2.0 * float(np.finfo(float).eps)
 
 
@@ -48,66 +51,76 @@ class Points(Protocol):
     def segment_points(self, a: Any, b: Any) -> list[Any]: ...
 
 
-class RealVectorPoints:
-    """Points of an ``ob.RealVectorStateSpace`` as ``(dim,)`` float64 arrays."""
+class ArrayPoints:
+    """Points of a space with a flat layout as ``(dim,)`` float64 arrays."""
 
-    def __init__(self, si: ob.SpaceInformation, rng: np.random.Generator) -> None:
-        space = si.getStateSpace()
-        self.dim = space.getDimension()
-        bounds = space.getBounds()
-        self.low = np.array(bounds.low, dtype=float)
-        self.high = np.array(bounds.high, dtype=float)
+    def __init__(self, si: ob.SpaceInformation, layout: SpaceLayout, rng: np.random.Generator) -> None:
+        self.layout = layout
+        self.dim = layout.dim
+        self._euclidean = layout.euclidean
         self._rng = rng
         self._block = np.empty((0, self.dim))
         self._next = 0
-        self._space = space
+        self._space = si.getStateSpace()
         self._si = si
+        self._read = state_reader(self._space)
         # Two scratch OMPL states: checks take a pair (nearest, new) at a time.
         self._scratch = (si.allocState(), si.allocState())
 
     def new_tree(self) -> ArrayTree:
-        return ArrayTree(self.dim)
+        return ArrayTree(self.dim, layout=self.layout)
 
     def sample(self) -> np.ndarray:
-        """A uniform sample within the bounds, ``(dim,)``."""
+        """A uniform sample of the space, ``(dim,)`` (a view into the current block of samples)."""
         if self._next == len(self._block):
-            self._block = self._rng.uniform(self.low, self.high, size=(_SAMPLE_BLOCK, self.dim))
+            uniforms = self._rng.random((SAMPLE_BLOCK, self.layout.total_draws))
+            self._block = flat.samples_from_uniforms(self.layout, uniforms)
             self._next = 0
         point = self._block[self._next]
         self._next += 1
         return point
 
-    @staticmethod
-    def distance(a: np.ndarray, b: np.ndarray) -> float:
-        offset = b - a
-        return math.sqrt(offset @ offset)
+    def distance(self, a: np.ndarray, b: np.ndarray) -> float:
+        """OMPL's distance (the squares of a real-vector space summed over the coordinates in
+        order, as the tree scans and the compiled engine sum them, to the last bit)."""
+        if self._euclidean:
+            squares = ((b - a) ** 2).tolist()
+            total = squares[0]
+            for square in squares[1:]:
+                total += square
+            return math.sqrt(total)
+        return flat.distance(self.layout, a, b)
 
-    @staticmethod
-    def interpolate(a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
-        """The point a fraction ``t`` of the way from ``a`` to ``b``."""
-        return a + t * (b - a)
+    def interpolate(self, a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
+        """The point a fraction ``t`` of the way from ``a`` to ``b`` (OMPL's interpolation)."""
+        if self._euclidean:
+            return a + t * (b - a)
+        return flat.interpolate(self.layout, a, b, t)
 
-    @staticmethod
-    def equal(a: np.ndarray, b: np.ndarray) -> bool:
-        """Equal within OMPL's ``RealVectorStateSpace::equalStates`` tolerance."""
-        return float(np.abs(a - b).max()) <= _EQUAL_TOLERANCE
+    def equal(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """Equal within OMPL's ``equalStates`` tolerance."""
+        if self._euclidean:
+            return float(np.abs(a - b).max()) <= _EQUAL_TOLERANCE
+        return flat.equal(self.layout, a, b)
 
     def may_stall(self, step: float) -> bool:
         """Whether a move of length ``step`` can round back onto its start point.
 
-        Only when ``step`` is within rounding of the coordinates' magnitude; planners
-        skip the no-progress test otherwise.
+        In a real-vector space only when ``step`` is within rounding of the coordinates'
+        magnitude (planners skip the no-progress test otherwise); always where a leaf turns.
         """
-        largest = max(float(np.abs(self.low).max(initial=0.0)), float(np.abs(self.high).max(initial=0.0)))
+        if not self._euclidean:
+            return True
+        largest = max(float(np.abs(self.layout.low).max(initial=0.0)), float(np.abs(self.layout.high).max(initial=0.0)))
         return step <= 4.0 * _EQUAL_TOLERANCE * largest * math.sqrt(self.dim)
 
     def is_finite(self, state: ob.State) -> bool:
         """``False`` when an OMPL state has a NaN or infinite value (bounds checks miss NaN)."""
-        return all(math.isfinite(value) for value in state[0 : self.dim])
+        return all(math.isfinite(value) for value in self._read(state))
 
     def from_state(self, state: ob.State) -> np.ndarray:
         """A copy of an OMPL state's values, ``(dim,)``."""
-        return np.array(state[0 : self.dim], dtype=float)
+        return np.array(self._read(state), dtype=float)
 
     def ompl_state(self, point: np.ndarray, slot: int = 0) -> ob.State:
         """``point`` written into scratch OMPL state ``slot`` (0 or 1); valid until reused."""
@@ -129,7 +142,7 @@ class RealVectorPoints:
         known valid. (OMPL's ``getMotionStates`` would place them at ``j / (n + 1)``,
         between the checked ones.)
         """
-        count = self._space.validSegmentCount(self.ompl_state(a, 0), self.ompl_state(b, 1))
+        count = flat.segment_count(self.layout, a, b)
         return [self.interpolate(a, b, step / count) for step in range(1, count)] + [b]
 
 
@@ -187,10 +200,7 @@ class StatePoints:
         return [self.interpolate(a, b, step / count) for step in range(1, count)] + [self.new_state(b)]
 
 
-def _is_real_vector(si: ob.SpaceInformation) -> bool:
-    return type(si.getStateSpace()) is ob.RealVectorStateSpace
-
-
 def points_for(si: ob.SpaceInformation, rng: np.random.Generator) -> Points:
-    """The fast array view for plain real-vector spaces, OMPL states otherwise."""
-    return RealVectorPoints(si, rng) if _is_real_vector(si) else StatePoints(si)
+    """Flat arrays for the spaces with a layout (:mod:`ompl_balance.core.layout`), OMPL states otherwise."""
+    layout = layout_for(si.getStateSpace())
+    return StatePoints(si) if layout is None else ArrayPoints(si, layout, rng)

@@ -3,9 +3,10 @@
 Two stores with one interface (:class:`Tree`), chosen by :mod:`ompl_balance.core.spaces`:
 
 :class:`ArrayTree`
-    real-vector states in one contiguous ``(capacity, dim)`` float64 array grown by
-    doubling; nearest and near neighbours by a scan of all nodes (exact): numpy while
-    the process's trees are small, the compiled kernels of :mod:`ompl_balance.core.scans`
+    flat states (:mod:`ompl_balance.core.layout`: real-vector spaces, SO(2), SO(3), SE(2),
+    SE(3) and compounds of them) in one contiguous ``(capacity, dim)`` float64 array grown
+    by doubling; nearest and near neighbours by a scan of all nodes (exact): numpy while
+    the process's trees are small, the compiled kernels of :mod:`ompl_balance.core.compiled_spaces`
     once a tree has reached :data:`COMPILED_SCANS_FROM` nodes and they have loaded in a
     background thread (so that no solve waits for numba), the same answers either way.
 :class:`StateTree`
@@ -24,10 +25,12 @@ import os
 import sys
 import threading
 from types import ModuleType
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 from ompl import base as ob
+
+from .layout import SpaceLayout, distances, squared_distances
 
 NO_PARENT = -1
 
@@ -65,12 +68,17 @@ class _Links:
     def _link(self, parent: int) -> int:
         index = self.size
         if index == len(self.parents):
-            self.parents = np.concatenate([self.parents, np.full(index, NO_PARENT, dtype=np.int64)])
-            self.roots = np.concatenate([self.roots, np.zeros(index, dtype=np.int64)])
+            self._grow_links(2 * index)
         self.parents[index] = parent
         self.roots[index] = index if parent == NO_PARENT else self.roots[parent]
         self.size = index + 1
         return index
+
+    def _grow_links(self, capacity: int) -> None:
+        grown = len(self.parents)
+        capacity = max(capacity, 2 * grown)
+        self.parents = np.concatenate([self.parents, np.full(capacity - grown, NO_PARENT, dtype=np.int64)])
+        self.roots = np.concatenate([self.roots, np.zeros(capacity - grown, dtype=np.int64)])
 
     def __len__(self) -> int:
         return self.size
@@ -136,14 +144,16 @@ class _ScanLoader:
         self.thread: threading.Thread | None = None
 
     def load(self) -> ModuleType:
-        from . import scans
+        from . import compiled_spaces
 
-        self.scans = scans
-        return scans
+        self.scans = compiled_spaces
+        return compiled_spaces
 
     def loaded(self) -> ModuleType | None:
         if self.scans is None and self.thread is None:
-            if "ompl_balance.core.scans" in sys.modules:  # imported by someone else, e.g. a forkserver's preload
+            if (
+                "ompl_balance.core.compiled_spaces" in sys.modules
+            ):  # imported by someone else, e.g. a forkserver's preload
                 return self.load()
             self.thread = threading.Thread(target=self.load, name="ompl_balance-load-scans")
             self.thread.start()
@@ -160,7 +170,7 @@ os.register_at_fork(before=_LOADER.finish)
 
 
 def load_scans() -> ModuleType:
-    """The compiled nearest/near scans (:mod:`ompl_balance.core.scans`), loaded now.
+    """The compiled scans (:mod:`ompl_balance.core.compiled_spaces`), loaded now.
 
     The first call in a process imports numba and loads the kernels (about half a second).
     """
@@ -173,31 +183,30 @@ def compiled_scans() -> ModuleType | None:
     return _LOADER.loaded()
 
 
-def _squared_distances(states: np.ndarray, query: np.ndarray) -> np.ndarray:
-    """Squared Euclidean distance of each row of ``states`` to ``query``, ``(len(states),)``.
+class TreeStorage(NamedTuple):
+    """An :class:`ArrayTree`'s arrays, for compiled code that adds nodes in place: ``states``
+    (capacity, dim), ``parents`` and ``roots`` (capacity,); rows ``[0, len(tree))`` are nodes."""
 
-    Summed over the coordinates in order, exactly as the compiled kernels do, so both
-    scans give the same numbers to the last bit.
-    """
-    offsets = states - query
-    squared = offsets[:, 0] * offsets[:, 0]
-    for k in range(1, offsets.shape[1]):
-        squared += offsets[:, k] * offsets[:, k]
-    return squared
+    states: np.ndarray
+    parents: np.ndarray
+    roots: np.ndarray
 
 
 class ArrayTree(_Links):
-    """Real-vector states of one tree, shape ``(len(tree), dim)``.
+    """Flat states of one tree, shape ``(len(tree), dim)``, with the metric of ``layout``
+    (:mod:`ompl_balance.core.layout`; ``None``: Euclidean).
 
     Nearest and near queries scan all nodes (exact): with numpy until the compiled kernels
     are loaded (a tree of :data:`COMPILED_SCANS_FROM` nodes starts their loading), then in
     one compiled loop (for the tree sizes sampling planners reach, faster than any index
-    would be from Python). Both scans return the same answers.
+    would be from Python). For real-vector states both scans return the same answers to
+    the last bit.
     """
 
-    def __init__(self, dim: int, capacity: int = 1024) -> None:
+    def __init__(self, dim: int, capacity: int = 1024, layout: SpaceLayout | None = None) -> None:
         super().__init__(capacity)
         self._states = np.empty((capacity, dim))
+        self._layout = None if layout is None or layout.euclidean else layout
         # scratch output of the compiled near(), one slot per node
         self._near_indices = np.empty(capacity, dtype=np.int64)
         self._near_distances = np.empty(capacity)
@@ -214,11 +223,33 @@ class ArrayTree(_Links):
         """Add ``state`` (``(dim,)``) as a child of ``parent``; return its index."""
         index = self._link(parent)
         if index == len(self._states):
-            self._states = np.concatenate([self._states, np.empty_like(self._states)])
-            self._near_indices = np.empty(len(self._states), dtype=np.int64)
-            self._near_distances = np.empty(len(self._states))
+            self._grow_states(2 * index)
         self._states[index] = state
         return index
+
+    def reserve(self, capacity: int) -> None:
+        """Make room for ``capacity`` nodes (doubling), so compiled code can add nodes in place."""
+        if capacity > len(self.parents):
+            self._grow_links(capacity)
+        if capacity > len(self._states):
+            self._grow_states(len(self.parents))
+
+    def storage(self) -> TreeStorage:
+        """The arrays behind the tree (valid until it grows); see :meth:`adopt`."""
+        return TreeStorage(self._states, self.parents, self.roots)
+
+    def adopt(self, size: int) -> None:
+        """Take rows ``[len(tree), size)`` of :meth:`storage`, written by compiled code, as new nodes."""
+        if not self.size <= size <= len(self._states):
+            raise ValueError(f"adopt({size}): the tree has {self.size} nodes and room for {len(self._states)}")
+        self.size = size
+
+    def _grow_states(self, capacity: int) -> None:
+        grown = np.empty((capacity, self._states.shape[1]))
+        grown[: len(self._states)] = self._states
+        self._states = grown
+        self._near_indices = np.empty(capacity, dtype=np.int64)
+        self._near_distances = np.empty(capacity)
 
     def _compiled(self) -> ModuleType | None:
         """The compiled scans once loaded (whatever the size); their loading starts when a
@@ -229,30 +260,43 @@ class ArrayTree(_Links):
         return scans
 
     def nearest(self, state: np.ndarray) -> tuple[int, float]:
-        """Index of the node closest to ``state`` (Euclidean; the first on ties) and its distance."""
+        """Index of the node closest to ``state`` (the first on ties) and its distance."""
         if self.size == 0:
             raise ValueError("nearest() of an empty tree: add a root first")
         scans = self._compiled()
+        if self._layout is not None:
+            if scans is None:
+                all_distances = distances(self._layout, self._states[: self.size], state)
+                index = int(all_distances.argmin())
+                return index, float(all_distances[index])
+            index, nearest_distance = scans.nearest(self._layout, self._states, self.size, state)
+            return index, nearest_distance
         if scans is None:
-            squared = _squared_distances(self._states[: self.size], state)
+            squared = squared_distances(self._states[: self.size], state)
             index = int(squared.argmin())
             return index, math.sqrt(squared[index])
-        index, nearest_squared = scans.nearest(self._states, self.size, state)
+        index, nearest_squared = scans.euclidean_nearest(self._states, self.size, state)
         return index, math.sqrt(nearest_squared)
 
     def near(self, state: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the nodes within ``radius`` of ``state`` (exact, ascending) and their distances."""
+        if self._layout is not None:
+            all_distances = self.distances(state)
+            indices = np.flatnonzero(all_distances <= radius)
+            return indices, all_distances[indices]
         scans = self._compiled()
         if scans is None:
-            squared = _squared_distances(self._states[: self.size], state)
+            squared = squared_distances(self._states[: self.size], state)
             indices = np.flatnonzero(squared <= radius * radius)
             return indices, np.sqrt(squared[indices])
-        count = scans.within(self._states, self.size, state, radius, self._near_indices, self._near_distances)
+        count = scans.euclidean_within(self._states, self.size, state, radius, self._near_indices, self._near_distances)
         return self._near_indices[:count].copy(), self._near_distances[:count].copy()
 
     def distances(self, state: np.ndarray) -> np.ndarray:
-        """Euclidean distance from every node to ``state``, ``(len(tree),)``."""
-        return np.sqrt(_squared_distances(self._states[: self.size], state))
+        """The distance from every node to ``state``, ``(len(tree),)``."""
+        if self._layout is not None:
+            return distances(self._layout, self._states[: self.size], state)
+        return np.sqrt(squared_distances(self._states[: self.size], state))
 
     def _keep_states(self, kept: np.ndarray) -> None:
         self._states[: len(kept)] = self._states[kept]
