@@ -47,7 +47,7 @@ from .planners import (
     RunStats,
     SwapLimitRRTConnect,
 )
-from .policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause, balance_choice, tree_size_ratio
+from .policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause, balance_choice, choose_tree
 from .rrtstar import BallRadiusRRTstar, RRTstarStats
 from .samplers import BridgeTestValidStateSampler, GaussianValidStateSampler, PassageSampler
 from .worlds.boxes import PROBLEMS, BoxWorld2D, Problem, get_problem
@@ -141,6 +141,7 @@ __all__ = [
     "__version__",
     "balance_choice",
     "ball_radius_constant",
+    "choose_tree",
     "ensure_counting",
     "estimate_ball_radius_constant",
     "estimate_free_measure",
@@ -150,7 +151,6 @@ __all__ = [
     "rewire_radius",
     "rooms_grid",
     "rooms_problem",
-    "tree_size_ratio",
     "unit_ball_volume",
 ]
 

@@ -23,10 +23,8 @@ compared (``SwapLimitRRTConnect``, ...); ``docs/variants.md`` measures them.
 
 from __future__ import annotations
 
-import enum
 import itertools
 import math
-import sys
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any, ClassVar
@@ -35,27 +33,39 @@ import numpy as np
 from ompl import base as ob
 from ompl import util as ou
 
+from .core.counting import WorkCount
+from .core.layout import layout_for
 from .core.params import Settings, param
 from .core.planner import GOAL_TAG, RANGE_AS_EXTENT_FRACTION, START_TAG, PlannerSpecs, TreePlanner
-from .core.spaces import Points
+from .core.spaces import ArrayPoints, Points
 from .core.trees import NO_PARENT, Tree
+from .engine import python_loop
+from .engine.compiled import CompiledRun, prepared, room_per_iteration
+from .engine.compiled import load as load_engine
+from .engine.events import LoopCounts, LoopRecord
+from .engine.solve import Solve
 from .policies import (
     NEAREST_POLICIES,
     SAMPLE_POLICIES,
     SWAP_POLICIES,
-    NearestFinder,
     NodeFailures,
     SampleContext,
     SamplerCounts,
     SwapCause,
-    nearest_finder,
-    target_sampler,
-    tree_chooser,
+    SwapState,
+    TreeChoice,
+    nearest_choice,
+    target_choice,
 )
 from .samplers import PassageSampler
 
 #: ``allocate(si) -> ob.ValidStateSampler`` (a valid-state sampler class is one).
 ValidStateSamplerAllocator = Callable[[Any], Any]
+
+#: ``engine`` choices: the compiled engine where it applies (else Python), always compiled, always Python.
+ENGINES = ("auto", "compiled", "python")
+#: Nodes one iteration may add beyond which a solve stays on the Python engine (a tiny ``range``).
+MAX_ROOM = 1 << 20
 
 
 @dataclass
@@ -93,8 +103,8 @@ class RRTConnectSettings(Settings):
     swap_steps: int = param(10, "connect steps after which balance_steps swaps trees", low=1, suggestion="1:1:100")
     nearest_policy: str = param(
         "euclidean",
-        "the node a tree grows from: the nearest, the nearest not exhausted (exhausted_after), "
-        "or the least distance x exhaustion scale (exhaustion_target)",
+        "the node a tree grows from: the nearest (the space's metric), the nearest not exhausted "
+        "(exhausted_after), or the least distance x exhaustion scale (exhaustion_target)",
         choices=NEAREST_POLICIES,
     )
     exhausted_after: int = param(15, "failed extensions after which a node is exhausted", low=1, suggestion="1:1:100")
@@ -103,7 +113,7 @@ class RRTConnectSettings(Settings):
     )
     sample_policy: str = param(
         "uniform",
-        "where each iteration's target comes from (see ompl_balance.policies.target_sampler)",
+        "where each iteration's target comes from (see ompl_balance.policies.target_choice)",
         choices=SAMPLE_POLICIES,
     )
     goal_bias: float = param(
@@ -124,9 +134,17 @@ class RRTConnectSettings(Settings):
     seed: int = param(
         0,
         "0: each solve draws its seed from an OMPL RNG (repeated by ompl.util.RNG.setSeed); > 0: every solve "
-        "uses this seed (real-vector spaces; other spaces sample with OMPL's sampler and seed)",
+        "uses this seed (real-vector, SO(2), SO(3), SE(2), SE(3) spaces and their compounds; other spaces "
+        "sample with OMPL's sampler and seed)",
         low=0,
         suggestion="0:1:1000000",
+    )
+    engine: str = param(
+        "auto",
+        "the loop's implementation: compiled (numba; the spaces seed names, every sample_policy but "
+        "valid_sampler, the package's checkers called as compiled kernels), python (any space and policy), "
+        "or auto: compiled where it applies and is loaded, else python (the same trees in real-vector spaces)",
+        choices=ENGINES,
     )
 
 
@@ -154,6 +172,11 @@ class RunStats:
         ``sample()`` returning ``False``).
     sampler_checks: validity checks made inside the valid-state sampler (part of
         ``states_checked``, not in addition to it).
+    engine: the loop that ran, ``"compiled"`` or ``"python"``.
+    checks: how the compiled engine made the checks: ``"kernel"`` (the checker's compiled
+        kernels) or ``"python"`` (``si.isValid``/``si.checkMotion``); ``"python"`` on the Python engine.
+    exits: calls from compiled code out to Python (FCL queries a kernel cannot decide, a
+        Python checker's calls); 0 on the Python engine.
     """
 
     status: str
@@ -171,77 +194,24 @@ class RunStats:
     swaps_collision: int = 0
     sampler_rejections: int = 0
     sampler_checks: int = 0
+    engine: str = "python"
+    checks: str = "python"
+    exits: int = 0
 
     def as_dict(self) -> dict[str, float | int | str]:
         return asdict(self)
 
 
-class Grow(enum.Enum):
-    """Outcome of one extension step, as OMPL's ``RRTConnect::GrowState``."""
-
-    TRAPPED = 0  # no progress: the motion was invalid
-    ADVANCED = 1  # a step of length ``range`` towards the target was added
-    REACHED = 2  # the target itself was added
-
-
 @dataclass
-class Extender:
-    """One solve's extension step: what :meth:`grow` needs, fixed for the solve."""
+class _LoopOutcome:
+    """What :meth:`BalancedRRTConnect._plan` measured, for :class:`RunStats`."""
 
-    points: Points
-    range: float
-    intermediate_states: bool
-    is_valid: Callable[[ob.State], bool]
-    check_motion: Callable[[ob.State, ob.State], bool]
-    step_may_stall: bool  # whether a step of ``range`` can round back onto its start
-    find_nearest: NearestFinder | None  # the nearest policy; None: the nearest node
-    failures: dict[Tree, NodeFailures]  # recorded while a failure-counting nearest policy is on
-
-    def grow(self, tree: Tree, from_start: bool, target: Any, nearest: int | None = None) -> tuple[Grow, int, float]:
-        """Extend ``tree`` one step towards ``target``.
-
-        Returns the outcome, the node added (``NO_PARENT`` when trapped) and the distance
-        from the node extended to ``target`` (before the step). The node extended is
-        ``nearest`` when given, else the one the nearest policy picks. Motions in the start
-        tree are checked from the tree outwards; in the goal tree they run from the new
-        state into the tree, so the new state is checked first (``checkMotion`` assumes its
-        first state valid), exactly as OMPL does. A motion in collision counts as a failed
-        extension of the node (when the nearest policy counts failures).
-        """
-        points = self.points
-        if nearest is None:
-            nearest, distance = tree.nearest(target) if self.find_nearest is None else self.find_nearest(tree, target)
-        else:
-            distance = points.distance(tree.state(nearest), target)
-        near = tree.state(nearest)
-        reach = distance <= self.range
-        new = target if reach else points.interpolate(near, target, self.range / distance)
-        if not reach and self.step_may_stall and points.equal(near, new):
-            return Grow.TRAPPED, NO_PARENT, distance
-
-        near_state, new_state = points.ompl_state(near, 0), points.ompl_state(new, 1)
-        if from_start:
-            valid = self.check_motion(near_state, new_state)
-        else:
-            valid = self.is_valid(new_state) and self.check_motion(new_state, near_state)
-        if not valid:
-            if self.find_nearest is not None:
-                self.failures[tree].record(nearest)
-            return Grow.TRAPPED, NO_PARENT, distance
-
-        if self.intermediate_states:
-            # States along the motion, ordered away from the tree's root.
-            added = nearest
-            for point in points.segment_points(near, new):
-                added = tree.add(point, added)
-        else:
-            added = tree.add(new, nearest)
-        return (Grow.REACHED if reach else Grow.ADVANCED), added, distance
-
-
-#: ``(grew_start, steps, collided)`` before the first iteration: as if the goal tree had
-#: just been grown and every rule were due to swap, so the first iteration grows the start tree.
-_FIRST_LOOP_STATE = (False, sys.maxsize, True)
+    counts: LoopCounts
+    sampler: SamplerCounts
+    start_tree_size: int
+    goal_tree_size: int
+    engine: str = "python"
+    checks: str = "python"
 
 
 class BalancedRRTConnect(TreePlanner):
@@ -257,6 +227,10 @@ class BalancedRRTConnect(TreePlanner):
     Subclasses preset policies through ``POLICIES`` (parameter values set at
     construction) and ``VALID_STATE_SAMPLER`` (an allocator); their planner name is
     their class name. See :data:`PRESETS`.
+
+    ``planner.loop_record = LoopRecord()`` (:class:`~ompl_balance.engine.events.LoopRecord`)
+    makes the following solves append every tree choice and extension step to it, on
+    either engine; ``None`` (the default) records nothing.
     """
 
     Settings = RRTConnectSettings
@@ -277,15 +251,17 @@ class BalancedRRTConnect(TreePlanner):
         self.settings.update({**self.POLICIES, "intermediate_states": bool(addIntermediateStates)})
         self._valid_state_sampler_allocator: ValidStateSamplerAllocator | None = type(self).VALID_STATE_SAMPLER
         self._valid_sampler: ob.ValidStateSampler | None = None
-        # The trees and what the policies record per node: kept across solves until clear().
+        # The trees and what the policies keep per node and between iterations: kept across
+        # solves until clear().
         self._start_tree: Tree | None = None
         self._goal_tree: Tree | None = None
         self._failures: dict[Tree, NodeFailures] = {}
-        self._loop_state = _FIRST_LOOP_STATE
+        self._swap_state = SwapState()
         # For the planner data, as OMPL's: the nodes joined by the last solution (start tree,
         # goal tree), and the least distance between the trees seen after a connect.
         self._connection: tuple[int, int] | None = None
         self._distance_between_trees = math.inf
+        self.loop_record: LoopRecord | None = None
 
     @property
     def draws_from_ompl_rng(self) -> bool:
@@ -308,15 +284,37 @@ class BalancedRRTConnect(TreePlanner):
             ou.OMPL_INFORM(f"{self.getName()}: range computed to be {self.settings.range:g}")
         self._check_policies()
         self._valid_sampler = None  # allocated again from the current allocator
+        if self.settings.engine != "python" and not self._why_not_compiled():
+            si = self.getSpaceInformation()
+            layout = layout_for(si.getStateSpace())
+            assert layout is not None
+            load_engine(si, layout, wait=self.settings.engine == "compiled")
 
     def _check_policies(self) -> None:
         """Refuse combinations of policies and parameters that cannot do what they say."""
-        if self.draws_from_ompl_rng and self.settings.seed > 0:
+        name, settings = self.getName(), self.settings
+        if self.draws_from_ompl_rng and settings.seed > 0:
             raise ValueError(
-                f"{self.getName()}: sample_policy=valid_sampler with seed={self.settings.seed}: a valid-state sampler "
+                f"{name}: sample_policy=valid_sampler with seed={settings.seed}: a valid-state sampler "
                 "draws from OMPL's RNG, which the seed parameter cannot repeat; use seed=0 (and "
                 "ompl.util.RNG.setSeed) or another sample_policy"
             )
+        if settings.engine == "compiled":
+            reason = self._why_not_compiled()
+            if reason:
+                raise ValueError(f"{name}: engine=compiled cannot run {reason}; use engine=auto or engine=python")
+
+    def _why_not_compiled(self, points: Points | None = None) -> str:
+        """Why the compiled engine cannot run this planner's solves ('' when it can)."""
+        if self.settings.sample_policy == "valid_sampler":
+            return "sample_policy=valid_sampler (a valid-state sampler is an OMPL object called per sample)"
+        space = self.getSpaceInformation().getStateSpace()
+        if points is None:
+            if layout_for(space) is None:
+                return f"a {type(space).__name__} (it plans in real-vector, SO(2), SO(3), SE(2), SE(3) spaces and their compounds)"
+        elif not isinstance(points, ArrayPoints):
+            return f"a {type(space).__name__} (it plans in real-vector, SO(2), SO(3), SE(2), SE(3) spaces and their compounds)"
+        return ""
 
     def _before_solve(self, ptc: ob.PlannerTerminationCondition) -> None:
         self._check_policies()
@@ -325,7 +323,7 @@ class BalancedRRTConnect(TreePlanner):
         super().clear()
         self._start_tree = self._goal_tree = None
         self._failures = {}
-        self._loop_state = _FIRST_LOOP_STATE
+        self._swap_state = SwapState()
         self._connection = None
         self._distance_between_trees = math.inf
 
@@ -333,27 +331,23 @@ class BalancedRRTConnect(TreePlanner):
 
     def _plan(
         self, ptc: ob.PlannerTerminationCondition, points: Points, rng: np.random.Generator
-    ) -> tuple[ob.PlannerStatus.PlannerStatusType, dict[str, Any]]:
-        """The grow/connect loop; returns the status and the loop's statistics."""
-        settings, name = self.settings, self.getName()
-        si = self.getSpaceInformation()
+    ) -> tuple[ob.PlannerStatus.PlannerStatusType, _LoopOutcome]:
+        """The grow/connect loop on the engine the settings choose; returns the status and what it measured."""
+        name = self.getName()
         if self._start_tree is None or self._goal_tree is None:
             self._start_tree, self._goal_tree = points.new_tree(), points.new_tree()
             self._failures = {self._start_tree: NodeFailures(), self._goal_tree: NodeFailures()}
         start_tree, goal_tree = self._start_tree, self._goal_tree
-        swaps = [0] * len(SwapCause)
-        counts = SamplerCounts()
 
-        def result(status: ob.PlannerStatus.PlannerStatusType, iterations: int = 0) -> tuple[Any, dict[str, Any]]:
-            return status, dict(
-                iterations=iterations,
-                start_tree_size=len(start_tree),
-                goal_tree_size=len(goal_tree),
-                tree_swaps=sum(swaps),
-                sampler_rejections=counts.rejections,
-                sampler_checks=counts.checks,
-                **{f"swaps_{cause.name.lower()}": swaps[cause] for cause in SwapCause},
-            )
+        def result(
+            status: ob.PlannerStatus.PlannerStatusType,
+            solve: Solve | None = None,
+            engine: str = "python",
+            checks: str = "python",
+        ) -> tuple[Any, _LoopOutcome]:
+            counts = LoopCounts() if solve is None else solve.counts
+            sampler = SamplerCounts() if solve is None else solve.sampler_counts
+            return status, _LoopOutcome(counts, sampler, len(start_tree), len(goal_tree), engine, checks)
 
         pdef = self.getProblemDefinition()  # keep the owner alive while its states are used
         goal = pdef.getGoal()
@@ -375,91 +369,92 @@ class BalancedRRTConnect(TreePlanner):
         ou.OMPL_INFORM(
             f"{name}: Starting planning with {len(start_tree) + len(goal_tree)} states already in datastructure"
         )
-
-        # The policies of this solve.
-        choose_tree = tree_chooser(
-            settings.swap_policy, settings.balance_tree_sizes, settings.max_tree_size_ratio, settings.swap_steps
-        )
-        find_nearest = nearest_finder(
-            settings.nearest_policy, self._failures, settings.exhausted_after, settings.exhaustion_target
-        )
-        extender = Extender(
-            points,
-            settings.range,
-            settings.intermediate_states,
-            si.isValid,
-            si.checkMotion,
-            points.may_stall(settings.range),
-            find_nearest,
-            self._failures,
-        )
-        sample = target_sampler(settings.sample_policy, self._sample_context(points, rng, counts, find_nearest))
-        nearest_is_euclidean = find_nearest is None
-
-        status = ob.PlannerStatus.TIMEOUT
-        progress = self.progress
-        grew_start, steps, collided = self._loop_state
-        while not ptc():
-            # Goal states join the goal tree while fewer than half of its states were sampled.
-            if len(goal_tree) == 0 or inputs.getSampledGoalsCount() < len(goal_tree) // 2:
-                state = inputs.nextGoal(ptc) if len(goal_tree) == 0 else inputs.nextGoal()
-                if state is not None and points.is_finite(state):
-                    goal_tree.add(points.from_state(state))
-                if len(goal_tree) == 0:
-                    ou.OMPL_ERROR(f"{name}: Unable to sample any valid states for goal tree")
-                    status = ob.PlannerStatus.INVALID_GOAL
-                    break
-            progress.iterations += 1
-
-            grow_start, cause = choose_tree(grew_start, len(start_tree), len(goal_tree), steps, collided)
-            if grow_start != grew_start:
-                steps, collided = 0, False
-                if progress.iterations > 1:
-                    swaps[cause] += 1
-            grew_start = grow_start
-            tree, other_tree = (start_tree, goal_tree) if grow_start else (goal_tree, start_tree)
-
-            target, nearest = sample(grow_start)
-            if target is None:
-                continue
-            grown, added, _ = extender.grow(tree, grow_start, target, nearest)
-            if grown is Grow.TRAPPED:
-                continue
-            # Connect: walk the other tree towards the state just added until trapped or there.
-            target = tree.state(added)  # stays valid: only the other tree grows while connecting
-            connected, reached, gap = extender.grow(other_tree, not grow_start, target)
-            steps += 1
-            while connected is Grow.ADVANCED:
-                # Each further step extends the node just added (why not the nearest policy's
-                # choice: see policies.nearest_finder).
-                connected, reached, gap = extender.grow(other_tree, not grow_start, target, nearest=reached)
-                steps += 1
-            # OMPL's "approx goal distance": the other tree's nearest node to the state just
-            # added, after the connect (the node the last step extended, for the plain nearest).
-            if connected is Grow.REACHED:
-                gap = 0.0
-            elif not nearest_is_euclidean:
-                gap = other_tree.nearest(target)[1]
-            self._distance_between_trees = min(self._distance_between_trees, gap)
-            collided = connected is Grow.TRAPPED
-            if collided:
-                continue
-            start_node, goal_node = (added, reached) if grow_start else (reached, added)
-            start_root = points.ompl_state(start_tree.state(start_tree.root(start_node)), 0)
-            goal_root = points.ompl_state(goal_tree.state(goal_tree.root(goal_node)), 1)
-            if goal.isStartGoalPairValid(start_root, goal_root):
-                path = self._path_points(start_node, goal_node)
-                self._add_solution(points, path)
-                progress.best_cost = sum(points.distance(a, b) for a, b in itertools.pairwise(path))
-                status = ob.PlannerStatus.EXACT_SOLUTION
-                break
-
-        self._loop_state = (grew_start, steps, collided)
+        solve = self._solve(points, rng, inputs, goal)
+        compiled = self._compiled_engine(solve)
+        if compiled is None:
+            status = python_loop.run(solve, ptc)
+            engine, checks = "python", "python"
+        else:
+            status, checks = compiled(ptc)
+            engine = "compiled"
+        self._distance_between_trees = solve.tree_gap
+        if status == ob.PlannerStatus.EXACT_SOLUTION:
+            assert solve.connection is not None
+            path = self._path_points(*solve.connection)
+            self._add_solution(points, path)
+            self.progress.best_cost = sum(points.distance(a, b) for a, b in itertools.pairwise(path))
         ou.OMPL_INFORM(
             f"{name}: Created {len(start_tree) + len(goal_tree)} states "
             f"({len(start_tree)} start + {len(goal_tree)} goal)"
         )
-        return result(status, progress.iterations)
+        return result(status, solve, engine, checks)
+
+    def _solve(self, points: Points, rng: np.random.Generator, inputs: ob.PlannerInputStates, goal: Any) -> Solve:
+        """This solve's policies around the planner's trees."""
+        settings = self.settings
+        assert self._start_tree is not None and self._goal_tree is not None
+        tree_choice = TreeChoice(
+            settings.swap_policy,
+            self._swap_state,
+            settings.balance_tree_sizes,
+            settings.max_tree_size_ratio,
+            settings.swap_steps,
+        )
+        nearest = nearest_choice(
+            settings.nearest_policy, self._failures, settings.exhausted_after, settings.exhaustion_target
+        )
+        context = SampleContext(
+            points,
+            self._start_tree,
+            self._goal_tree,
+            rng.random,
+            SamplerCounts(),
+            nearest,
+            settings.goal_bias,
+            settings.min_quality,
+            settings.uniform_rate,
+        )
+        if settings.sample_policy == "valid_sampler":
+            si = self.getSpaceInformation()
+            context.valid_sampler = self._valid_state_sampler()
+            context.checker, context.scratch = si.getStateValidityChecker(), si.allocState()
+        return Solve(
+            name=self.getName(),
+            si=self.getSpaceInformation(),
+            points=points,
+            settings=settings,
+            start_tree=self._start_tree,
+            goal_tree=self._goal_tree,
+            failures=self._failures,
+            tree_choice=tree_choice,
+            nearest=nearest,
+            targets=target_choice(settings.sample_policy, context),
+            sample_context=context,
+            inputs=inputs,
+            goal=goal,
+            progress=self.progress,
+            rng=rng,
+            record=self.loop_record,
+            tree_gap=self._distance_between_trees,
+        )
+
+    def _compiled_engine(self, solve: Solve) -> CompiledRun | None:
+        """The compiled engine's run of ``solve``, or ``None`` when this solve runs on the Python engine."""
+        settings = self.settings
+        if settings.engine == "python" or self._why_not_compiled(solve.points):
+            return None
+        points = solve.points
+        assert isinstance(points, ArrayPoints)
+        extent = solve.si.getStateSpace().getMaximumExtent()
+        room = room_per_iteration(points.layout, extent, settings.range, settings.intermediate_states)
+        if room > MAX_ROOM:
+            if settings.engine == "compiled":
+                raise ValueError(
+                    f"{self.getName()}: engine=compiled with range={settings.range:g}: an iteration may add "
+                    f"{room} nodes; use a larger range or engine=python"
+                )
+            return None
+        return prepared(solve, points.layout, room, wait=settings.engine == "compiled", name=self.getName())
 
     def _progress_extras(self) -> dict[str, Callable[[], str]]:
         return {
@@ -467,26 +462,28 @@ class BalancedRRTConnect(TreePlanner):
             "goal tree size INTEGER": lambda: str(len(self._goal_tree or ())),
         }
 
-    def _sample_context(
-        self, points: Points, rng: np.random.Generator, counts: SamplerCounts, find_nearest: NearestFinder | None
-    ) -> SampleContext:
-        assert self._start_tree is not None and self._goal_tree is not None
-        context = SampleContext(
-            points,
-            self._start_tree,
-            self._goal_tree,
-            rng.random,
-            counts,
-            find_nearest,
-            self.settings.goal_bias,
-            self.settings.min_quality,
-            self.settings.uniform_rate,
+    def _statistics(self, status: str, work: WorkCount, elapsed: float, outcome: _LoopOutcome) -> RunStats:
+        counts, swaps = outcome.counts, outcome.counts.swaps
+        return RunStats(
+            status=status,
+            iterations=counts.iterations,
+            start_tree_size=outcome.start_tree_size,
+            goal_tree_size=outcome.goal_tree_size,
+            tree_swaps=sum(swaps),
+            states_checked=work.states_checked,
+            motions_checked=work.motions_checked,
+            time=elapsed,
+            distance_queries=work.distance_queries,
+            swaps_alternate=swaps[SwapCause.ALTERNATE],
+            swaps_balance=swaps[SwapCause.BALANCE],
+            swaps_steps=swaps[SwapCause.STEPS],
+            swaps_collision=swaps[SwapCause.COLLISION],
+            sampler_rejections=outcome.sampler.rejections,
+            sampler_checks=outcome.sampler.checks,
+            engine=outcome.engine,
+            checks=outcome.checks,
+            exits=counts.exits,
         )
-        if self.settings.sample_policy == "valid_sampler":
-            si = self.getSpaceInformation()
-            context.valid_sampler = self._valid_state_sampler()
-            context.checker, context.scratch = si.getStateValidityChecker(), si.allocState()
-        return context
 
     def _valid_state_sampler(self) -> ob.ValidStateSampler:
         """The valid-state sampler of ``sample_policy = valid_sampler``, allocated once per setup."""

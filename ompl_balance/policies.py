@@ -1,18 +1,22 @@
 """The RRT-Connect family's policies: which tree grows, from which node, towards what.
 
 RRT-Connect's loop (:mod:`ompl_balance.planners`) asks three questions each iteration;
-each answer is a policy, chosen by one parameter and made into a function once per solve,
-so a policy that is not selected costs the loop nothing:
+each answer is a policy, chosen by one parameter and built once per solve, so a policy that
+is not selected costs the loop nothing:
 
-``swap_policy`` and ``balance_tree_sizes`` -> :func:`tree_chooser`
+``swap_policy`` and ``balance_tree_sizes`` -> :class:`TreeChoice`
     which tree an iteration grows: the balancing rule (grow the smaller tree once the
     trees drift apart in size), else alternation, the swap limiter or the collision swap;
-``nearest_policy`` -> :func:`nearest_finder`
+``nearest_policy`` -> :func:`nearest_choice`
     which node the tree grows from: the nearest, the nearest not yet exhausted, or the
     nearest by distance scaled with the node's failures;
-``sample_policy`` -> :func:`target_sampler`
+``sample_policy`` -> :func:`target_choice`
     where the iteration's target comes from: uniform, goal bias, the goal ball ("control
     chosen"), neighbour quality, or a valid-state sampler.
+
+The rules themselves are plain functions of numbers (:func:`choose_tree`,
+:func:`exhaustion_scale`, :func:`node_quality`, ...): the Python engine calls them here, the
+compiled engine (:mod:`ompl_balance.engine.loop`) compiles the same functions.
 
 These are the variants compared against RRT-Connect in the TU Berlin lab report "RRT
 Extensions" (2020); ``docs/variants.md`` measures them.
@@ -23,7 +27,7 @@ from __future__ import annotations
 import enum
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from ompl import base as ob
@@ -55,91 +59,130 @@ class SwapCause(enum.IntEnum):
 SWAP_CAUSES = tuple(cause.name.lower() for cause in SwapCause)
 
 
-def tree_size_ratio(start_size: int, goal_size: int) -> float:
-    """``|a - b| / min(a, b)``: how much larger the larger tree is, relative to the smaller.
-
-    Dividing by the *smaller* size is what makes the rule engage: with ``max(a, b)`` in
-    the denominator (the first OMPL pull request) the ratio never reaches 1.
-    """
-    return abs(start_size - goal_size) / min(start_size, goal_size)
+def _choice(name: str, value: str, accepted: tuple[str, ...]) -> int:
+    if value not in accepted:
+        raise ValueError(f"unknown {name} {value!r}; accepted: {', '.join(accepted)}")
+    return accepted.index(value)
 
 
-def balance_choice(start_size: int, goal_size: int, balance: bool, max_ratio: float) -> bool | None:
-    """Which tree the balancing rule grows: ``True`` start, ``False`` goal, ``None`` no preference.
-
-    The smaller tree is grown when ``balance`` is on and
-    ``tree_size_ratio(start_size, goal_size) >= max_ratio``; otherwise (and when the
-    trees are equal) the swap policy decides.
-    """
-    if not balance or start_size == goal_size:
-        return None
-    if tree_size_ratio(start_size, goal_size) >= max_ratio:
-        return start_size < goal_size
-    return None
+# -- swap_policy and balancing -------------------------------------------------------------
 
 
-#: ``choose(grew_start, start_size, goal_size, steps, collided) -> (grow_start, cause)``
-TreeChooser = Callable[[bool, int, int, int, bool], tuple[bool, SwapCause]]
+def choose_tree(
+    swap_policy: int,
+    balance_tree_sizes: bool,
+    max_tree_size_ratio: float,
+    swap_steps: int,
+    grew_start: bool,
+    start_size: int,
+    goal_size: int,
+    steps: int,
+    collided: bool,
+) -> tuple[bool, SwapCause]:
+    """Which tree an iteration grows: ``(grow_start, cause)``, ``cause`` saying why, if it is a swap.
 
-
-def tree_chooser(
-    swap_policy: str, balance_tree_sizes: bool = False, max_tree_size_ratio: float = 1.0, swap_steps: int = 1
-) -> TreeChooser:
-    """The tree-choice rule as a function ``choose``.
-
-    ``choose(grew_start, start_size, goal_size, steps, collided)`` is given which tree
-    the previous iteration grew (``True``: the start tree), the tree sizes, the
-    extension steps taken in connect loops since the last swap, and whether the last
-    connect ended in a collision (the last two restart at every swap). It returns
-    ``(grow_start, cause)``, ``cause`` saying why the choice is a swap, when it is one.
-
-    With ``balance_tree_sizes``, the smaller tree is grown whenever
-    :func:`balance_choice` engages; otherwise ``swap_policy`` decides:
+    Given which tree the previous iteration grew (``grew_start``), the tree sizes, the
+    connect steps taken since the last swap and whether the last connect ended in a
+    collision. The balancing rule first: with ``balance_tree_sizes`` and trees of different
+    sizes ``a``, ``b``, when ``|a - b| / min(a, b) >= max_tree_size_ratio`` the smaller tree
+    grows. Dividing by the *smaller* size is what makes the rule engage: with ``max(a, b)``
+    in the denominator (the first OMPL pull request) the ratio never reaches 1. Otherwise
+    ``swap_policy`` (an index into :data:`SWAP_POLICIES`) decides:
 
     ``alternate``      the other tree, every iteration (stock RRT-Connect);
     ``balance_steps``  the same tree until ``swap_steps`` connect steps were taken since
                        the last swap, then the other (the swap limiter);
     ``on_collision``   the same tree until a connect ends in a collision, then the other.
     """
-    if swap_policy == "alternate":
+    if (
+        balance_tree_sizes
+        and start_size != goal_size
+        and abs(start_size - goal_size) / min(start_size, goal_size) >= max_tree_size_ratio
+    ):
+        return start_size < goal_size, SwapCause.BALANCE
+    if swap_policy == 0:
+        return not grew_start, SwapCause.ALTERNATE
+    if swap_policy == 1:
+        return (not grew_start if steps >= swap_steps else grew_start), SwapCause.STEPS
+    return (not grew_start if collided else grew_start), SwapCause.COLLISION
 
-        def rule(grew_start: bool, steps: int, collided: bool) -> tuple[bool, SwapCause]:
-            return not grew_start, SwapCause.ALTERNATE
 
-    elif swap_policy == "balance_steps":
+def balance_choice(start_size: int, goal_size: int, balance: bool, max_ratio: float) -> bool | None:
+    """Which tree the balancing rule grows: ``True`` start, ``False`` goal, ``None`` no preference
+    (the swap policy decides); see :func:`choose_tree`."""
+    grow_start, cause = choose_tree(0, balance, max_ratio, 1, False, start_size, goal_size, 0, False)
+    return grow_start if cause is SwapCause.BALANCE else None
 
-        def rule(grew_start: bool, steps: int, collided: bool) -> tuple[bool, SwapCause]:
-            return (not grew_start if steps >= swap_steps else grew_start), SwapCause.STEPS
 
-    elif swap_policy == "on_collision":
+#: The swap state before a planner's first iteration: as if the goal tree had just been grown
+#: and every rule were due to swap (connect steps beyond any limit, the last connect trapped),
+#: so the first iteration grows the start tree unless balancing decides otherwise.
+FIRST_SWAP_STATE = (False, 2**62, True)
 
-        def rule(grew_start: bool, steps: int, collided: bool) -> tuple[bool, SwapCause]:
-            return (not grew_start if collided else grew_start), SwapCause.COLLISION
 
-    else:
-        raise ValueError(f"unknown swap_policy {swap_policy!r}; accepted: {', '.join(SWAP_POLICIES)}")
-    if not balance_tree_sizes:
-        return lambda grew_start, start_size, goal_size, steps, collided: rule(grew_start, steps, collided)
+@dataclass
+class SwapState:
+    """What the tree choice remembers between iterations (and solves, until ``clear()``)."""
 
-    def balanced(
-        grew_start: bool, start_size: int, goal_size: int, steps: int, collided: bool
-    ) -> tuple[bool, SwapCause]:
-        smaller_is_start = balance_choice(start_size, goal_size, True, max_tree_size_ratio)
-        if smaller_is_start is None:
-            return rule(grew_start, steps, collided)
-        return smaller_is_start, SwapCause.BALANCE
+    grew_start: bool = FIRST_SWAP_STATE[0]  # the tree the last iteration grew
+    steps: int = FIRST_SWAP_STATE[1]  # connect steps since the last swap
+    collided: bool = FIRST_SWAP_STATE[2]  # the last connect ended trapped
 
-    return balanced
+
+class TreeChoice:
+    """The tree-choice rule of a solve: :meth:`next_tree` each iteration, told what connects did."""
+
+    def __init__(
+        self,
+        swap_policy: str,
+        state: SwapState,
+        balance_tree_sizes: bool = False,
+        max_tree_size_ratio: float = 1.0,
+        swap_steps: int = 1,
+    ) -> None:
+        self.swap_policy = _choice("swap_policy", swap_policy, SWAP_POLICIES)
+        self.state = state
+        self.balance_tree_sizes = balance_tree_sizes
+        self.max_tree_size_ratio = max_tree_size_ratio
+        self.swap_steps = swap_steps
+
+    def next_tree(self, start_size: int, goal_size: int) -> tuple[bool, SwapCause | None]:
+        """The tree this iteration grows (``True``: the start tree) and, if it is a swap, why."""
+        state = self.state
+        grow_start, cause = choose_tree(
+            self.swap_policy,
+            self.balance_tree_sizes,
+            self.max_tree_size_ratio,
+            self.swap_steps,
+            state.grew_start,
+            start_size,
+            goal_size,
+            state.steps,
+            state.collided,
+        )
+        swapped = grow_start != state.grew_start
+        if swapped:
+            state.steps, state.collided = 0, False
+        state.grew_start = grow_start
+        return grow_start, cause if swapped else None
+
+    def connect_stepped(self) -> None:
+        """A connect took one more step."""
+        self.state.steps += 1
+
+    def connect_ended(self, trapped: bool) -> None:
+        """A connect ended: trapped (in a collision) or not."""
+        self.state.collided = trapped
 
 
 # -- nearest_policy ------------------------------------------------------------------------
 
 
-def exhaustion_scale(failures: np.ndarray | int, target: int) -> np.ndarray | float:
+def exhaustion_scale(failures: Any, target: int) -> Any:
     """The exhaustion heuristic's distance factor, ``0.9 + 0.1 * |target - failures| / target``.
 
     1 for a node that never failed, lowest (0.9) for one that failed ``target`` times,
-    above 1 beyond ``2 * target`` failures.
+    above 1 beyond ``2 * target`` failures. ``failures`` is a count or an array of them.
     """
     return 0.9 + 0.1 * np.abs(target - failures) / target
 
@@ -164,37 +207,89 @@ class NodeFailures:
     """Failed extensions per node of one tree (an extension from the node hit a collision)."""
 
     def __init__(self, capacity: int = 1024) -> None:
-        self._counts = np.zeros(capacity, dtype=np.int64)
+        self.array = np.zeros(capacity, dtype=np.int64)  # counts of nodes 0 .. capacity - 1
 
-    def _reserve(self, size: int) -> None:
-        if size > len(self._counts):
-            grown = np.zeros(max(size, 2 * len(self._counts)), dtype=np.int64)
-            grown[: len(self._counts)] = self._counts
-            self._counts = grown
+    def reserve(self, size: int) -> None:
+        """Room for the counts of ``size`` nodes (grown by doubling, new nodes at 0)."""
+        if size > len(self.array):
+            grown = np.zeros(max(size, 2 * len(self.array)), dtype=np.int64)
+            grown[: len(self.array)] = self.array
+            self.array = grown
 
     def record(self, node: int) -> None:
-        self._reserve(node + 1)
-        self._counts[node] += 1
+        self.reserve(node + 1)
+        self.array[node] += 1
 
     def counts(self, size: int) -> np.ndarray:
         """Failures of nodes ``0 .. size - 1``, ``(size,)`` (a view)."""
-        self._reserve(size)
-        return self._counts[:size]
+        self.reserve(size)
+        return self.array[:size]
 
 
-#: ``find(tree, target) -> (node, distance)``: the node a tree grows from towards ``target``.
-NearestFinder = Callable[[Tree, Any], tuple[int, float]]
+class NearestChoice(Protocol):
+    """The node a tree grows from towards a target, and what a failed extension changes."""
+
+    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
+        """The node to extend and its distance to ``target``."""
+        ...
+
+    def failed(self, tree: Tree, node: int) -> None:
+        """An extension from ``node`` hit a collision."""
+        ...
 
 
-def nearest_finder(
+class NearestNode:
+    """``euclidean``: the nearest node (the space's metric)."""
+
+    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
+        return tree.nearest(target)
+
+    def failed(self, tree: Tree, node: int) -> None:
+        """Nothing to remember."""
+
+
+class _FailureCounting:
+    def __init__(self, failures: dict[Tree, NodeFailures]) -> None:
+        self.failures = failures
+
+    def failed(self, tree: Tree, node: int) -> None:
+        self.failures[tree].record(node)
+
+
+class NearestNotExhausted(_FailureCounting):
+    """``exhausted``: the nearest node with fewer than ``exhausted_after`` failures (:func:`nearest_not_exhausted`)."""
+
+    def __init__(self, failures: dict[Tree, NodeFailures], exhausted_after: int) -> None:
+        super().__init__(failures)
+        self.exhausted_after = exhausted_after
+
+    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
+        counts = self.failures[tree].counts(len(tree))
+        node, distance = tree.nearest(target)
+        if counts[node] < self.exhausted_after:
+            return node, distance  # the nearest of all is not exhausted: no need to rank
+        distances = tree.distances(target)
+        node = nearest_not_exhausted(distances, counts, self.exhausted_after)
+        return node, float(distances[node])
+
+
+class NearestByExhaustion(_FailureCounting):
+    """``exhaustion``: the least distance x :func:`exhaustion_scale` (``exhaustion_target``)."""
+
+    def __init__(self, failures: dict[Tree, NodeFailures], exhaustion_target: int) -> None:
+        super().__init__(failures)
+        self.exhaustion_target = exhaustion_target
+
+    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
+        distances = tree.distances(target)
+        node = nearest_by_exhaustion(distances, self.failures[tree].counts(len(tree)), self.exhaustion_target)
+        return node, float(distances[node])
+
+
+def nearest_choice(
     nearest_policy: str, failures: dict[Tree, NodeFailures], exhausted_after: int = 15, exhaustion_target: int = 5
-) -> NearestFinder | None:
-    """The node choice of ``nearest_policy``; ``None`` for the plain nearest (``tree.nearest``).
-
-    ``exhausted``: the nearest node with fewer than ``exhausted_after`` failures
-    (:func:`nearest_not_exhausted`); ``exhaustion``: the least distance x
-    :func:`exhaustion_scale` (``exhaustion_target``). ``failures`` holds each tree's
-    :class:`NodeFailures`, which the planner records while such a policy is selected.
+) -> NearestChoice:
+    """The node choice of ``nearest_policy``; ``failures`` holds each tree's :class:`NodeFailures`.
 
     The planner asks the policy for each extension step and for the first step of each
     connect. A connect's further steps extend the node the step before added, as
@@ -205,29 +300,12 @@ def nearest_finder(
     the node the step before extended; extending that one again lands on the state just
     added, so a connect asking the policy could add that state over and over and never end.
     """
-    if nearest_policy == "exhausted":
-
-        def not_exhausted(tree: Tree, target: Any) -> tuple[int, float]:
-            counts = failures[tree].counts(len(tree))
-            node, distance = tree.nearest(target)
-            if counts[node] < exhausted_after:
-                return node, distance  # the nearest of all is not exhausted: no need to rank
-            distances = tree.distances(target)
-            node = nearest_not_exhausted(distances, counts, exhausted_after)
-            return node, float(distances[node])
-
-        return not_exhausted
-    if nearest_policy == "exhaustion":
-
-        def by_exhaustion(tree: Tree, target: Any) -> tuple[int, float]:
-            distances = tree.distances(target)
-            node = nearest_by_exhaustion(distances, failures[tree].counts(len(tree)), exhaustion_target)
-            return node, float(distances[node])
-
-        return by_exhaustion
-    if nearest_policy == "euclidean":
-        return None
-    raise ValueError(f"unknown nearest_policy {nearest_policy!r}; accepted: {', '.join(NEAREST_POLICIES)}")
+    index = _choice("nearest_policy", nearest_policy, NEAREST_POLICIES)
+    if index == 1:
+        return NearestNotExhausted(failures, exhausted_after)
+    if index == 2:
+        return NearestByExhaustion(failures, exhaustion_target)
+    return NearestNode()
 
 
 # -- sample_policy -------------------------------------------------------------------------
@@ -274,9 +352,13 @@ class SamplerCounts:
     checks: int = 0  # validity checks made inside a valid-state sampler
 
 
-#: ``sample(grow_start) -> (target, nearest)``; ``target`` is ``None`` when the policy gave up
-#: the iteration, ``nearest`` the node to extend from when the policy already found it.
-TargetSampler = Callable[[bool], tuple[Any, int | None]]
+class TargetChoice(Protocol):
+    """Where an iteration's target comes from."""
+
+    def target(self, grow_start: bool) -> tuple[Any, int | None]:
+        """The target (``None``: the policy gave up the iteration) and the node to extend
+        towards it when the policy already found it (``None``: the nearest policy decides)."""
+        ...
 
 
 @dataclass
@@ -288,7 +370,7 @@ class SampleContext:
     goal_tree: Tree
     random: Callable[[], float]  # uniform in [0, 1), from the solve's generator
     counts: SamplerCounts
-    find_nearest: NearestFinder | None = None  # the nearest policy (None: tree.nearest)
+    nearest: NearestChoice | None = None  # the nearest policy (None: tree.nearest)
     goal_bias: float = 0.05
     min_quality: float = 0.0
     uniform_rate: float = 0.0  # goal_ball, neighbour_quality, valid_sampler: probability of a uniform target
@@ -297,99 +379,133 @@ class SampleContext:
     scratch: ob.State | None = None  # an OMPL state the valid-state sampler writes into
 
 
-def target_sampler(sample_policy: str, context: SampleContext) -> TargetSampler:
-    """The target choice of ``sample_policy`` as a function ``sample(grow_start)``.
+class UniformTargets:
+    """``uniform``: a uniform sample of the space."""
 
-    ``uniform``            a uniform sample within the bounds;
-    ``goal_bias``          with probability ``goal_bias`` the other tree's first root (the goal
-                           when growing the start tree, the start when growing the goal tree);
-    ``goal_ball``          a uniform sample no farther from the other tree's first root than
-                           start and goal are apart ("control chosen");
-    ``neighbour_quality``  a uniform sample kept with probability :func:`node_quality` of the
-                           node ``context.find_nearest`` (the nearest policy) picks for it;
-    ``valid_sampler``      a sample of ``context.valid_sampler``, or a uniform sample when it
-                           finds none (free space has no state near an obstacle).
+    def __init__(self, context: SampleContext) -> None:
+        self.sample = context.points.sample
+
+    def target(self, grow_start: bool) -> tuple[Any, int | None]:
+        return self.sample(), None
+
+
+class GoalBiasTargets:
+    """``goal_bias``: with probability ``goal_bias`` the other tree's first root, else uniform."""
+
+    def __init__(self, context: SampleContext) -> None:
+        self.context = context
+
+    def target(self, grow_start: bool) -> tuple[Any, int | None]:
+        context = self.context
+        if context.random() < context.goal_bias:
+            return (context.goal_tree if grow_start else context.start_tree).state(0), None
+        return context.points.sample(), None
+
+
+class GoalBallTargets:
+    """``goal_ball``: a uniform sample no farther from the other tree's first root than start
+    and goal are apart ("control chosen"); gives up after :data:`SAMPLE_ATTEMPTS` draws."""
+
+    def __init__(self, context: SampleContext) -> None:
+        self.context = context
+
+    def target(self, grow_start: bool) -> tuple[Any, int | None]:
+        context = self.context
+        distance = context.points.distance
+        centre = (context.goal_tree if grow_start else context.start_tree).state(0)
+        radius = distance(context.start_tree.state(0), context.goal_tree.state(0))
+        for _ in range(SAMPLE_ATTEMPTS):
+            point = context.points.sample()
+            if distance(point, centre) <= radius:
+                return point, None
+            context.counts.rejections += 1
+        return None, None
+
+
+class QualityTargets:
+    """``neighbour_quality``: a uniform sample kept with the probability :func:`node_quality` of
+    the node the nearest policy picks for it; gives up after :data:`SAMPLE_ATTEMPTS` draws."""
+
+    def __init__(self, context: SampleContext) -> None:
+        self.context = context
+        distance = context.points.distance
+        self.costs = {context.start_tree: NodeCosts(distance), context.goal_tree: NodeCosts(distance)}
+
+    def target(self, grow_start: bool) -> tuple[Any, int | None]:
+        context = self.context
+        distance = context.points.distance
+        tree = context.start_tree if grow_start else context.goal_tree
+        start, goal = context.start_tree.state(0), context.goal_tree.state(0)
+        costs = self.costs[tree]
+        costs.update(tree, start, goal)
+        optimal = distance(start, goal)
+        for _ in range(SAMPLE_ATTEMPTS):
+            point = context.points.sample()
+            nearest, _ = tree.nearest(point) if context.nearest is None else context.nearest.node(tree, point)
+            if context.random() < node_quality(costs.values[nearest], optimal, costs.max, context.min_quality):
+                return point, nearest
+            context.counts.rejections += 1
+        return None, None
+
+
+class ValidSamplerTargets:
+    """``valid_sampler``: a sample of the context's valid-state sampler, or a uniform sample when
+    it finds none (free space has no state near an obstacle)."""
+
+    def __init__(self, context: SampleContext) -> None:
+        if context.valid_sampler is None or context.checker is None or context.scratch is None:
+            raise ValueError("sample_policy valid_sampler needs a valid-state sampler, the checker and a scratch state")
+        self.context = context
+
+    def target(self, grow_start: bool) -> tuple[Any, int | None]:
+        context = self.context
+        before = context.checker.counters()["states_checked"]
+        found = context.valid_sampler.sample(context.scratch)  # type: ignore[union-attr]
+        context.counts.checks += context.checker.counters()["states_checked"] - before
+        if not found:
+            # a uniform target keeps the planner growing, as RRT-Connect would
+            context.counts.rejections += 1
+            return context.points.sample(), None
+        return context.points.from_state(context.scratch), None
+
+
+class MixedWithUniform:
+    """A policy whose iteration targets a uniform sample instead with probability ``uniform_rate``."""
+
+    def __init__(self, policy: TargetChoice, context: SampleContext) -> None:
+        self.policy = policy
+        self.context = context
+
+    def target(self, grow_start: bool) -> tuple[Any, int | None]:
+        context = self.context
+        if context.random() < context.uniform_rate:
+            return context.points.sample(), None
+        return self.policy.target(grow_start)
+
+
+_TARGETS: dict[str, Callable[[SampleContext], TargetChoice]] = {
+    "uniform": UniformTargets,
+    "goal_bias": GoalBiasTargets,
+    "goal_ball": GoalBallTargets,
+    "neighbour_quality": QualityTargets,
+    "valid_sampler": ValidSamplerTargets,
+}
+#: The policies that never target some states, made complete by uniform targets at ``uniform_rate``.
+_RESTRICTED = ("goal_ball", "neighbour_quality", "valid_sampler")
+
+
+def target_choice(sample_policy: str, context: SampleContext) -> TargetChoice:
+    """The target choice of ``sample_policy`` (see the classes above).
 
     ``goal_ball``, ``neighbour_quality`` and ``valid_sampler`` never target some states
     (those outside the ball; those whose nearest node has quality 0 under ``min_quality``
     0, such as the costliest node of a tree; those far from obstacles), which can leave a
     problem unsolved for ever. With probability ``context.uniform_rate`` their iteration
     targets a uniform sample instead, which makes them probabilistically complete as
-    RRT-Connect is. The rejecting policies give up the iteration after
-    :data:`SAMPLE_ATTEMPTS` draws.
+    RRT-Connect is.
     """
-    points, start_tree, goal_tree = context.points, context.start_tree, context.goal_tree
-    uniform, distance, random, counts = points.sample, points.distance, context.random, context.counts
-    uniform_rate = context.uniform_rate
-
-    def or_uniform(sampler: TargetSampler) -> TargetSampler:
-        """``sampler``, except that an iteration targets a uniform sample with probability ``uniform_rate``."""
-        if uniform_rate <= 0.0:
-            return sampler
-
-        def mixed(grow_start: bool) -> tuple[Any, int | None]:
-            return (uniform(), None) if random() < uniform_rate else sampler(grow_start)
-
-        return mixed
-
-    if sample_policy == "uniform":
-        return lambda grow_start: (uniform(), None)
-    if sample_policy == "goal_bias":
-        bias = context.goal_bias
-
-        def biased(grow_start: bool) -> tuple[Any, int | None]:
-            if random() < bias:
-                return (goal_tree if grow_start else start_tree).state(0), None
-            return uniform(), None
-
-        return biased
-    if sample_policy == "goal_ball":
-
-        def in_goal_ball(grow_start: bool) -> tuple[Any, int | None]:
-            centre = (goal_tree if grow_start else start_tree).state(0)
-            radius = distance(start_tree.state(0), goal_tree.state(0))
-            for _ in range(SAMPLE_ATTEMPTS):
-                point = uniform()
-                if distance(point, centre) <= radius:
-                    return point, None
-                counts.rejections += 1
-            return None, None
-
-        return or_uniform(in_goal_ball)
-    if sample_policy == "neighbour_quality":
-        costs = {start_tree: NodeCosts(distance), goal_tree: NodeCosts(distance)}
-        min_quality, find_nearest = context.min_quality, context.find_nearest
-
-        def quality_accepted(grow_start: bool) -> tuple[Any, int | None]:
-            tree = start_tree if grow_start else goal_tree
-            start, goal = start_tree.state(0), goal_tree.state(0)
-            tree_costs = costs[tree]
-            tree_costs.update(tree, start, goal)
-            optimal = distance(start, goal)
-            for _ in range(SAMPLE_ATTEMPTS):
-                point = uniform()
-                nearest, _ = tree.nearest(point) if find_nearest is None else find_nearest(tree, point)
-                if random() < node_quality(tree_costs.values[nearest], optimal, tree_costs.max, min_quality):
-                    return point, nearest
-                counts.rejections += 1
-            return None, None
-
-        return or_uniform(quality_accepted)
-    if sample_policy == "valid_sampler":
-        sampler, checker, state = context.valid_sampler, context.checker, context.scratch
-        if sampler is None or checker is None or state is None:
-            raise ValueError("sample_policy valid_sampler needs a valid-state sampler, the checker and a scratch state")
-
-        def from_valid_sampler(grow_start: bool) -> tuple[Any, int | None]:
-            before = checker.counters()["states_checked"]
-            found = sampler.sample(state)
-            counts.checks += checker.counters()["states_checked"] - before
-            if not found:
-                # No state near an obstacle within the sampler's attempts (free space has
-                # none): a uniform target keeps the planner growing, as RRT-Connect would.
-                counts.rejections += 1
-                return uniform(), None
-            return points.from_state(state), None
-
-        return or_uniform(from_valid_sampler)
-    raise ValueError(f"unknown sample_policy {sample_policy!r}; accepted: {', '.join(SAMPLE_POLICIES)}")
+    _choice("sample_policy", sample_policy, SAMPLE_POLICIES)
+    policy = _TARGETS[sample_policy](context)
+    if sample_policy in _RESTRICTED and context.uniform_rate > 0.0:
+        return MixedWithUniform(policy, context)
+    return policy

@@ -17,7 +17,8 @@ and may have
 A plain Python callable given to ``si.setStateValidityChecker`` counts nothing, so
 :func:`ensure_counting` wraps whatever checker the space information has in a
 :class:`CountingValidityChecker`. Motions checked by OMPL's own
-``DiscreteMotionValidator`` are read from its built-in counter.
+``DiscreteMotionValidator`` are read from its built-in counter, plus those the compiled engine
+decided by the same rule (counted by the validity checker).
 """
 
 from __future__ import annotations
@@ -25,9 +26,12 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from ompl import base as ob
 from ompl import geometric as og
+
+from .checks import Count, new_counts
 
 
 class CountingValidityChecker(ob.StateValidityChecker):
@@ -39,24 +43,37 @@ class CountingValidityChecker(ob.StateValidityChecker):
         The space information the checker belongs to.
     check:
         What decides validity: another ``ob.StateValidityChecker`` (its ``isValid``
-        is called) or a callable ``state -> bool``.
+        is called) or a callable ``state -> bool``. A callable with a ``compiled_view(counts)``
+        (the package's box worlds) also checks states for the compiled engine, which
+        counts its states, and the motions it decides with OMPL's discrete rule, here too.
     """
 
     def __init__(self, si: ob.SpaceInformation, check: ob.StateValidityChecker | Callable[[ob.State], bool]):
         super().__init__(si)
         self._check = check.isValid if isinstance(check, ob.StateValidityChecker) else check
-        self.states_checked = 0
+        self.states_checked = 0  # by isValid; compiled code counts in self._compiled_counts
+        self._compiled_counts = new_counts()
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         self.states_checked += 1
         return bool(self._check(state))
 
+    def compiled_view(self) -> Any:
+        """The wrapped callable's compiled view (:mod:`ompl_balance.core.checks`), or ``None``."""
+        view_of = getattr(self._check, "compiled_view", None)
+        return None if view_of is None else view_of(self._compiled_counts)
+
     def counters(self) -> dict[str, int]:
-        """``{"states_checked": n}``: states decided since construction or the last reset."""
-        return {"states_checked": self.states_checked}
+        """States decided since construction or the last reset (by ``isValid`` and by compiled
+        code) and the motions compiled code decided (OMPL's validator counts the others)."""
+        return {
+            "states_checked": self.states_checked + int(self._compiled_counts[Count.STATES]),
+            "motions_checked": int(self._compiled_counts[Count.MOTIONS]),
+        }
 
     def reset_counters(self) -> None:
         self.states_checked = 0
+        self._compiled_counts[:] = 0
 
 
 @dataclass(frozen=True)
@@ -102,13 +119,11 @@ def read_work(si: ob.SpaceInformation) -> WorkCount:
     checker = si.getStateValidityChecker()
     counters = checker.counters() if hasattr(checker, "counters") else {}
     validator = si.getMotionValidator()
-    if validator is None:
-        motions = 0
-    elif hasattr(validator, "counters"):
+    if validator is not None and hasattr(validator, "counters"):
         counters = {**counters, **validator.counters()}
         motions = counters["motions_checked"]
-    else:
-        motions = validator.getCheckedMotionCount()
+    else:  # OMPL's own validator, and the motions compiled code decided by its rule
+        motions = counters.get("motions_checked", 0) + (0 if validator is None else validator.getCheckedMotionCount())
     return WorkCount(counters.get("states_checked", 0), motions, counters.get("distance_queries", 0))
 
 

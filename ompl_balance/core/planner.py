@@ -35,7 +35,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from .counting import ensure_counting, read_work
+from .counting import WorkCount, ensure_counting, read_work
 from .params import ParamSet, Settings, add_accessors
 from .spaces import Points, points_for
 from .trees import NO_PARENT, Tree
@@ -228,17 +228,22 @@ class TreePlanner(ob.Planner):
         rng = np.random.default_rng(self.settings.seed or self._draw_seed())
         self._points = points_for(si, rng)
         self.progress = Progress()
-        status, fields = self._plan(ptc, self._points, rng)
+        status, measured = self._plan(ptc, self._points, rng)
         work = read_work(si) - work_before
-        self.stats = self.Stats(
-            status=ob.PlannerStatus(status).asString(),
+        self.stats = self._statistics(ob.PlannerStatus(status).asString(), work, time.perf_counter() - began, measured)
+        return ob.PlannerStatus(status)
+
+    def _statistics(self, status: str, work: WorkCount, elapsed: float, measured: Any) -> Any:
+        """The ``Stats`` record of a solve: its status, the checkers' work, the seconds it took and
+        what :meth:`_plan` measured (by default a dict of the other fields of ``Stats``)."""
+        return self.Stats(
+            status=status,
             states_checked=work.states_checked,
             motions_checked=work.motions_checked,
             distance_queries=work.distance_queries,
-            time=time.perf_counter() - began,
-            **fields,
+            time=elapsed,
+            **measured,
         )
-        return ob.PlannerStatus(status)
 
     def progressProperties(self) -> dict[str, Callable[[], str]]:  # noqa: N802 (OMPL's style)
         """OMPL's planner progress properties: ``"name TYPE"`` -> a function giving the current
@@ -268,8 +273,8 @@ class TreePlanner(ob.Planner):
 
     def _plan(
         self, ptc: ob.PlannerTerminationCondition, points: Points, rng: np.random.Generator
-    ) -> tuple[ob.PlannerStatus.PlannerStatusType, dict[str, Any]]:
-        """The search; returns the status and the fields of ``Stats`` it measured."""
+    ) -> tuple[ob.PlannerStatus.PlannerStatusType, Any]:
+        """The search; returns the status and what it measured (see :meth:`_statistics`)."""
         raise NotImplementedError
 
     # -- output ----------------------------------------------------------------------

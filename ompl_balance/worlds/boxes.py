@@ -17,13 +17,25 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
+import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from ..core.checks import kernels_in
 from ..core.counting import CountingValidityChecker
 
 Box = tuple[float, float, float, float]  # x_min, y_min, x_max, y_max
+
+
+@kernels_in("ompl_balance.worlds.box_kernels")
+class BoxKernel(NamedTuple):
+    """A box world's compiled view (:mod:`ompl_balance.core.checks`): ``boxes`` (n, 4) rows of
+    ``x_min, y_min, x_max, y_max``; the checks count in ``counts``."""
+
+    boxes: np.ndarray
+    counts: np.ndarray
 
 
 class BoxWorld2D:
@@ -34,6 +46,10 @@ class BoxWorld2D:
             if len(box) != 4 or box[0] > box[2] or box[1] > box[3]:
                 raise ValueError(f"a box is (x_min, y_min, x_max, y_max) with min <= max, got {box!r}")
         self.boxes = tuple(tuple(float(v) for v in box) for box in boxes)
+
+    def compiled_view(self, counts: np.ndarray) -> BoxKernel:
+        """The view compiled code checks states with, counting in ``counts`` (a checker's counter)."""
+        return BoxKernel(np.array(self.boxes, dtype=float).reshape(-1, 4), counts)
 
     def is_free(self, x: float, y: float) -> bool:
         """``True`` when the point ``(x, y)`` lies in no box (``False`` for NaN or infinite)."""

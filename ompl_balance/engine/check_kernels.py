@@ -1,0 +1,68 @@
+"""The compiled kernels of the engine's own check views (:mod:`ompl_balance.engine.views`)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, objmode
+
+from ..core.check_overloads import register_kernels
+from ..core.checks import Count, state_free
+from ..core.compiled_spaces import interpolate, segment_count
+from .views import DiscreteMotions, PythonChecks, call_check_motion, call_is_valid
+
+
+@njit(cache=True)
+def _discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
+    """OMPL's ``DiscreteMotionValidator::checkMotion(s1, s2)``: ``b`` first, then the states
+    ``a + (j / n) (b - a)`` in the order of its queue of index ranges (the middle of each
+    range, then its halves)."""
+    view.counts[Count.MOTIONS] += 1
+    if not state_free(view.states, b):
+        return False
+    n = segment_count(view.layout, a, b)
+    if n < 2:
+        return True
+    queue = view.queue
+    if queue.shape[0] < n:
+        queue = np.empty((2 * n, 2), dtype=np.int64)
+    head, tail = 0, 1
+    queue[0, 0], queue[0, 1] = 1, n - 1
+    while head != tail:
+        first, last = queue[head, 0], queue[head, 1]
+        head = (head + 1) % queue.shape[0]
+        middle = (first + last) // 2
+        interpolate(view.layout, a, b, middle / n, view.test)
+        if not state_free(view.states, view.test):
+            return False
+        if first < middle:
+            queue[tail, 0], queue[tail, 1] = first, middle - 1
+            tail = (tail + 1) % queue.shape[0]
+        if last > middle:
+            queue[tail, 0], queue[tail, 1] = middle + 1, last
+            tail = (tail + 1) % queue.shape[0]
+    return True
+
+
+@njit(cache=True)
+def _python_state_free(view: PythonChecks, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    view.counts[Count.EXITS] += 1
+    with objmode(free="boolean"):
+        free = call_is_valid(view.handle, q)
+    return free
+
+
+@njit(cache=True)
+def _python_motion_free(view: PythonChecks, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    view.counts[Count.EXITS] += 1
+    with objmode(free="boolean"):
+        free = call_check_motion(view.handle, a, b)
+    return free
+
+
+@njit(cache=True)
+def _discrete_state_free(view: DiscreteMotions, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    return state_free(view.states, q)
+
+
+register_kernels(DiscreteMotions, state=_discrete_state_free, motion=_discrete_motion_free)
+register_kernels(PythonChecks, state=_python_state_free, motion=_python_motion_free)

@@ -1,0 +1,104 @@
+"""Whether a solve runs on the compiled engine, and running it.
+
+:func:`prepared` is what the planner asks before each solve: it builds the solve's check view
+(:mod:`ompl_balance.engine.views`), and returns the compiled engine's run when the engine for
+that kind of view is loaded in this process (or, with ``wait``, after loading it); otherwise it
+starts loading it in the background (:mod:`ompl_balance.engine.loading`) and returns ``None``,
+and the solve runs on the Python engine. Nothing here imports numba: a process that never
+plans on the compiled engine never loads it.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from collections.abc import Callable
+from functools import partial
+from typing import Any
+
+from ompl import base as ob
+from ompl import util as ou
+
+from ..core.checks import kernel_modules
+from ..core.layout import SpaceLayout
+from .loading import LOADER, view_key
+from .solve import Solve
+from .views import EngineChecks, checks_for
+
+#: ``run(ptc) -> (status, checks)``: a solve on the compiled engine; ``checks`` is how it checked.
+CompiledRun = Callable[[ob.PlannerTerminationCondition], tuple[Any, str]]
+
+
+def room_per_iteration(layout: SpaceLayout, extent: float, step: float, intermediate_states: bool) -> int:
+    """Nodes one iteration can add to a tree: the extension step and a connect of at most
+    ``extent / step + 1`` steps (``step``: the planner's range), each of one node (or of its
+    motion's states with ``intermediate_states``), and a goal state."""
+    steps = math.ceil(extent / step) + 2
+    per_step = 1
+    if intermediate_states:
+        for factor, segment, weight in zip(layout.factor, layout.segment, layout.weight):
+            reach = min(step / weight, extent) if weight > 0.0 else extent
+            per_step = max(per_step, int(factor) * math.ceil(reach / segment))
+    return steps * per_step + 1
+
+
+def _warm(view: Any, layout: SpaceLayout) -> None:
+    for module in kernel_modules(view):
+        importlib.import_module(module)
+    from .driver import warm_up
+
+    warm_up(view, layout)
+
+
+def load(si: ob.SpaceInformation, layout: SpaceLayout, wait: bool) -> None:
+    """Start loading the compiled engine for ``si``'s checks in the background, or (``wait``) load it now.
+
+    Planners call this from ``setup()``: ``SimpleSetup.solve`` sets up before the solve's
+    time limit starts, so a wait here (``engine=compiled``) does not eat into the solve.
+    """
+    checks = checks_for(si, layout)
+    key = view_key((checks.view, layout))
+    warm = partial(_warm, checks.view, layout)
+    try:
+        if wait:
+            LOADER.wait(key, warm, _describe(checks))
+        else:
+            LOADER.start(key, warm)
+    finally:
+        checks.close()
+
+
+def prepared(solve: Solve, layout: SpaceLayout, room: int, wait: bool, name: str) -> CompiledRun | None:
+    """The compiled engine's run of ``solve`` if it is ready (``wait``: made ready now), else ``None``."""
+    checks = checks_for(solve.si, layout)
+    key = view_key((checks.view, layout))
+    if wait:
+        LOADER.wait(key, partial(_warm, checks.view, layout), _describe(checks))
+    elif not LOADER.ready(key):
+        failure = LOADER.failure(key)
+        if failure is None:
+            LOADER.start(key, partial(_warm, checks.view, layout))
+            ou.OMPL_INFORM(f"{name}: the compiled engine is loading in the background; this solve runs on Python")
+        else:
+            ou.OMPL_WARN(f"{name}: the compiled engine failed to compile ({failure}); solving on Python")
+        checks.close()
+        return None
+    return partial(_run, solve, checks, layout, room)
+
+
+def _run(
+    solve: Solve, checks: EngineChecks, layout: SpaceLayout, room: int, ptc: ob.PlannerTerminationCondition
+) -> tuple[Any, str]:
+    from .driver import run
+
+    try:
+        return run(solve, ptc, checks, layout, room), checks.path
+    finally:
+        checks.close()
+
+
+def _describe(checks: EngineChecks) -> str:
+    """The kind of checks, in words, for the compiling message."""
+    view = checks.view
+    inner = getattr(view, "states", None)
+    return type(view).__name__ if inner is None else f"{type(view).__name__} of {type(inner).__name__}"

@@ -1,0 +1,220 @@
+"""The Python side of the compiled engine: one solve, in slices between which Python acts.
+
+:func:`run` prepares the arrays :func:`ompl_balance.engine.loop.run` works in (the
+planner's own trees, grown in place), then calls it in slices of iterations, adapting the
+slice so that one lasts about a millisecond: between slices it polls the termination
+condition (and Python raises a pending ``KeyboardInterrupt``), and it acts on why the
+slice stopped: a goal state to feed (OMPL's ``PlannerInputStates``), room to make in the
+trees, a connection for the goal to accept. At the end the planner's trees, swap state,
+counts and loop record hold what the compiled loop did, as if the Python engine had run.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from ompl import base as ob
+
+from ..core.checks import Count
+from ..core.layout import SpaceLayout
+from ..core.spaces import SAMPLE_BLOCK
+from ..core.trees import ArrayTree
+from ..policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause
+from . import loop
+from .events import Grow, GrowStep, TreeChoiceEvent
+from .loop import Real, Record, Slot, Stop
+from .solve import Solve
+from .views import EngineChecks
+
+#: A slice of iterations lasts about this long (s): the termination condition's polling period.
+SLICE_SECONDS = 1e-3
+#: Iterations of the largest slice.
+MAX_BUDGET = 1 << 16
+
+
+def settings_of(solve: Solve) -> loop.Settings:
+    """The compiled loop's settings for ``solve``."""
+    settings = solve.settings
+    return loop.Settings(
+        range=float(settings.range),
+        intermediate_states=bool(settings.intermediate_states),
+        step_may_stall=bool(solve.points.may_stall(settings.range)),
+        balance_tree_sizes=bool(settings.balance_tree_sizes),
+        max_tree_size_ratio=float(settings.max_tree_size_ratio),
+        swap_policy=SWAP_POLICIES.index(settings.swap_policy),
+        swap_steps=int(settings.swap_steps),
+        nearest_policy=NEAREST_POLICIES.index(settings.nearest_policy),
+        exhausted_after=int(settings.exhausted_after),
+        exhaustion_target=int(settings.exhaustion_target),
+        sample_policy=SAMPLE_POLICIES.index(settings.sample_policy),
+        goal_bias=float(settings.goal_bias),
+        uniform_rate=float(settings.uniform_rate),
+        min_quality=float(settings.min_quality),
+        record=solve.record is not None,
+    )
+
+
+class _Arrays:
+    """The arrays of one compiled solve, grown when the loop asks for room."""
+
+    def __init__(self, solve: Solve, layout: SpaceLayout, room: int, record: bool) -> None:
+        self.solve = solve
+        self.room = room
+        dim = layout.dim
+        self.costs = [np.empty(0), np.empty(0)]
+        self.loop = loop.Loop(
+            sizes=np.zeros(2, dtype=np.int64),
+            ints=np.zeros(Slot.COUNT, dtype=np.int64),
+            reals=np.zeros(Real.COUNT),
+            block=np.empty((SAMPLE_BLOCK, dim)),
+            uniforms=np.empty((SAMPLE_BLOCK, layout.total_draws)),
+            step=np.empty(dim),
+            target=np.empty(dim),
+            record=np.empty((4 * room + 64 if record else 0, Record.COUNT), dtype=np.int64),
+            record_target=np.empty((4 * room + 64 if record else 0, dim)),
+        )
+        self.trees = self.make_room()
+
+    def tree_list(self) -> list[ArrayTree]:
+        return [self.solve.start_tree, self.solve.goal_tree]  # type: ignore[list-item]
+
+    def make_room(self) -> tuple[loop.Tree, loop.Tree]:
+        """Room for one more iteration in both trees (and the record); the trees' arrays as the loop takes them."""
+        trees = []
+        for t, tree in enumerate(self.tree_list()):
+            needed = len(tree) + self.room
+            tree.reserve(needed)
+            storage = tree.storage()
+            capacity = len(storage.parents)
+            failures = self.solve.failures[tree]
+            failures.reserve(capacity)
+            if len(self.costs[t]) < capacity:
+                grown = np.empty(capacity)
+                grown[: len(self.costs[t])] = self.costs[t]
+                self.costs[t] = grown
+            trees.append(loop.Tree(storage.states, storage.parents, storage.roots, failures.array, self.costs[t]))
+            self.loop.sizes[t] = len(tree)
+        record = self.loop.record
+        if len(record) and len(record) - self.loop.ints[Slot.RECORDED] < self.room + 2:
+            rows = 2 * len(record) + self.room
+            self.loop = self.loop._replace(
+                record=_grown(record, rows), record_target=_grown(self.loop.record_target, rows)
+            )
+        return trees[0], trees[1]
+
+    def adopt(self) -> None:
+        """The planner's trees take the nodes the loop added."""
+        for t, tree in enumerate(self.tree_list()):
+            tree.adopt(int(self.loop.sizes[t]))
+
+
+def _grown(array: np.ndarray, rows: int) -> np.ndarray:
+    grown = np.empty((rows, *array.shape[1:]), dtype=array.dtype)
+    grown[: len(array)] = array
+    return grown
+
+
+def run(
+    solve: Solve, ptc: ob.PlannerTerminationCondition, checks: EngineChecks, layout: SpaceLayout, room: int
+) -> ob.PlannerStatus.PlannerStatusType:
+    """The loop of ``solve`` on the compiled engine, as :func:`ompl_balance.engine.python_loop.run`."""
+    settings = settings_of(solve)
+    arrays = _Arrays(solve, layout, room, settings.record)
+    ints, reals = arrays.loop.ints, arrays.loop.reals
+    state = solve.tree_choice.state
+    ints[Slot.GREW_START], ints[Slot.STEPS], ints[Slot.COLLIDED] = state.grew_start, state.steps, state.collided
+    ints[Slot.NEXT_SAMPLE] = SAMPLE_BLOCK  # a fresh block at the first sample, as the Python engine's
+    ints[Slot.ROOM] = room
+    reals[Real.TREE_GAP] = solve.tree_gap
+    exits_before = int(checks.view.counts[Count.EXITS])
+    status = ob.PlannerStatus.TIMEOUT
+    budget = 1
+    try:
+        while not ptc():
+            ints[Slot.SAMPLED_GOALS] = solve.inputs.getSampledGoalsCount()
+            ints[Slot.MORE_GOALS] = solve.inputs.haveMoreGoalStates()
+            began = time.perf_counter()
+            stop = loop.run(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
+            arrays.adopt()
+            solve.progress.iterations = int(ints[Slot.ITERATIONS])
+            if stop == Stop.BUDGET:
+                elapsed = time.perf_counter() - began
+                if elapsed < 0.25 * SLICE_SECONDS:
+                    budget = min(2 * budget, MAX_BUDGET)
+                elif elapsed > 2.0 * SLICE_SECONDS:
+                    budget = max(1, budget // 2)
+            elif stop == Stop.NEED_ROOM:
+                arrays.trees = arrays.make_room()
+            elif stop == Stop.NEED_GOAL:
+                if not solve.feed_goal(ptc):
+                    status = ob.PlannerStatus.INVALID_GOAL
+                    break
+                arrays.trees = arrays.make_room()
+                ints[Slot.GOAL_FED] = 1
+            elif solve.accept(int(ints[Slot.START_NODE]), int(ints[Slot.GOAL_NODE])):
+                status = ob.PlannerStatus.EXACT_SOLUTION
+                break
+    finally:
+        arrays.adopt()
+        _report(solve, arrays, settings, int(checks.view.counts[Count.EXITS]) - exits_before)
+    return status
+
+
+def _report(solve: Solve, arrays: _Arrays, settings: loop.Settings, exits: int) -> None:
+    """Hand what the compiled loop did to the planner's side: swap state, counts, gap, record."""
+    ints, reals = arrays.loop.ints, arrays.loop.reals
+    state = solve.tree_choice.state
+    state.grew_start, state.steps, state.collided = (
+        bool(ints[Slot.GREW_START]),
+        int(ints[Slot.STEPS]),
+        bool(ints[Slot.COLLIDED]),
+    )
+    counts = solve.counts
+    counts.iterations = int(ints[Slot.ITERATIONS])
+    counts.swaps = [int(ints[Slot.SWAPS + cause]) for cause in SwapCause]
+    counts.exits = exits
+    solve.sampler_counts.rejections += int(ints[Slot.REJECTIONS])
+    solve.progress.iterations = counts.iterations
+    solve.tree_gap = float(reals[Real.TREE_GAP])
+    if solve.record is not None:
+        _fill_record(solve, arrays.loop)
+
+
+def _fill_record(solve: Solve, arrays: loop.Loop) -> None:
+    record = solve.record
+    assert record is not None
+    rows, targets = arrays.record, arrays.record_target
+    for row in range(int(arrays.ints[Slot.RECORDED])):
+        iteration, kind, a, b, c, d, e = (int(value) for value in rows[row])
+        if kind == 0:
+            cause = None if e < 0 else SwapCause(e)
+            record.choices.append(TreeChoiceEvent(iteration, bool(a), b, bool(c), bool(d), cause))
+        else:
+            record.steps.append(GrowStep(iteration, bool(a), kind == 2, targets[row].copy(), b, bool(c), Grow(d), e))
+
+
+def warm_up(view: object, layout: SpaceLayout) -> None:
+    """Compile :func:`ompl_balance.engine.loop.run` for ``view``'s kind of checks (or load it from
+    numba's cache): a call of no iterations with arrays of the types a solve passes."""
+    settings = loop.Settings(1.0, False, False, True, 1.0, 0, 1, 0, 1, 1, 0, 0.0, 0.0, 0.0, False)
+    dim = layout.dim
+    tree = loop.Tree(
+        np.zeros((1, dim)),
+        np.zeros(1, dtype=np.int64),
+        np.zeros(1, dtype=np.int64),
+        np.zeros(1, dtype=np.int64),
+        np.zeros(1),
+    )
+    arrays = loop.Loop(
+        sizes=np.zeros(2, dtype=np.int64),
+        ints=np.zeros(Slot.COUNT, dtype=np.int64),
+        reals=np.zeros(Real.COUNT),
+        block=np.empty((SAMPLE_BLOCK, dim)),
+        uniforms=np.empty((SAMPLE_BLOCK, layout.total_draws)),
+        step=np.empty(dim),
+        target=np.empty(dim),
+        record=np.empty((0, Record.COUNT), dtype=np.int64),
+        record_target=np.empty((0, dim)),
+    )
+    loop.run(view, layout, settings, (tree, tree), arrays, np.random.default_rng(0), 0)

@@ -1,0 +1,97 @@
+"""Compiling (or loading from numba's disk cache) the compiled engine without making a solve wait.
+
+numba compiles :func:`ompl_balance.engine.loop.run` once per kind of check view (a box world
+with OMPL's discrete motions, a robot with certified motions, ...) and caches the machine
+code on disk, so only the first use after an install compiles (tens of seconds); later
+processes load it (about a second, most of it numba's own start-up). :class:`EngineLoader`
+does either in a background thread: ``engine=auto`` solves on the Python engine until the
+compiled one is ready, ``engine=compiled`` waits for it, with a message on standard error
+when the wait exceeds a second.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+import time
+from collections.abc import Callable, Hashable
+from typing import Any
+
+import numpy as np
+
+#: Seconds a solve waits for the compiled engine before it says that it is compiling.
+QUIET_WAIT = 1.0
+
+
+def view_key(value: Any) -> Any:
+    """What numba compiles a specialization of the engine for, as a hashable key: the classes of
+    named tuples with the keys of their fields, arrays by dtype, dimensions and layout, scalars by type."""
+    if isinstance(value, tuple) and hasattr(value, "_fields"):
+        return (type(value), tuple(view_key(field) for field in value))
+    if isinstance(value, tuple):
+        return tuple(view_key(item) for item in value)
+    if isinstance(value, np.ndarray):
+        return (value.dtype.str, value.ndim, value.flags.c_contiguous, value.flags.writeable)
+    return type(value)
+
+
+class EngineLoader:
+    """Background compilation of the engine's specializations, one thread per kind of view."""
+
+    def __init__(self) -> None:
+        self._ready: set[Hashable] = set()
+        self._threads: dict[Hashable, threading.Thread] = {}
+        self._errors: dict[Hashable, BaseException] = {}
+        self._lock = threading.Lock()
+
+    def ready(self, key: Hashable) -> bool:
+        """Whether the engine for ``key`` is compiled and loaded in this process."""
+        return key in self._ready
+
+    def failure(self, key: Hashable) -> BaseException | None:
+        """Why compiling the engine for ``key`` failed, if it did."""
+        return self._errors.get(key)
+
+    def start(self, key: Hashable, warm: Callable[[], None]) -> None:
+        """Compile or load the engine for ``key`` in the background (``warm()`` does it), unless under way or done."""
+        with self._lock:
+            if key in self._ready or key in self._threads:
+                return
+            thread = threading.Thread(target=self._warm, args=(key, warm), name="ompl_balance-engine", daemon=True)
+            self._threads[key] = thread
+        thread.start()
+
+    def wait(self, key: Hashable, warm: Callable[[], None], what: str) -> None:
+        """Make the engine for ``key`` ready now, saying on standard error when that takes more than a second."""
+        self.start(key, warm)
+        thread = self._threads[key]
+        began = time.perf_counter()
+        thread.join(QUIET_WAIT)
+        if thread.is_alive():
+            sys.stderr.write(
+                f"ompl_balance: compiling the planning engine for {what} (once: later processes load it from "
+                "numba's cache)...\n"
+            )
+            sys.stderr.flush()
+            thread.join()
+            sys.stderr.write(f"ompl_balance: compiled in {time.perf_counter() - began:.0f} s\n")
+        if key in self._errors:
+            raise RuntimeError(f"the compiled engine for {what} failed to compile") from self._errors[key]
+
+    def finish(self) -> None:
+        """Wait for every background compilation (a process must not fork in the middle of one)."""
+        for thread in list(self._threads.values()):
+            thread.join()
+
+    def _warm(self, key: Hashable, warm: Callable[[], None]) -> None:
+        try:
+            warm()
+        except BaseException as error:  # reported by wait(); auto keeps the Python engine
+            self._errors[key] = error
+            return
+        self._ready.add(key)
+
+
+LOADER = EngineLoader()
+os.register_at_fork(before=LOADER.finish)

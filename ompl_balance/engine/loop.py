@@ -1,0 +1,401 @@
+"""The grow/connect loop of the RRT-Connect family, compiled.
+
+:func:`run` is :meth:`ompl_balance.planners.BalancedRRTConnect`'s loop as OMPL's
+``RRTConnect::solve`` has it (and the Python engine runs it): each iteration picks the
+tree to grow (balancing, then the swap policy), draws a target (the sample policy), grows
+the tree one step towards it from the node the nearest policy picks, and walks the other
+tree towards the state just added until it is trapped or reaches it. It calls the
+checker's kernels through the view it is given (:mod:`ompl_balance.core.checks`), so numba
+compiles it once per kind of checker.
+
+It runs at most ``budget`` iterations and returns why it stopped (:class:`Stop`), so the
+Python side (:mod:`ompl_balance.engine.driver`) polls the termination condition between
+calls, feeds goal states, makes room in the trees and ends the solve when the trees
+connect. Everything it changes lives in arrays the caller owns (:class:`Loop`), so a call
+resumes where the last one stopped. The rules themselves (balancing, swaps, exhaustion,
+node quality) are the functions of :mod:`ompl_balance.policies`, compiled here.
+"""
+
+from __future__ import annotations
+
+import enum
+from typing import Any, NamedTuple
+
+import numpy as np
+from numba import njit
+
+from .. import policies
+from ..core.checks import motion_free, state_free
+from ..core.compiled_spaces import distance, equal, interpolate, nearest, sample_from_uniforms, segment_count
+from ..core.layout import SpaceLayout
+from .events import Grow
+
+choose_tree = njit(cache=True)(policies.choose_tree)
+exhaustion_scale = njit(cache=True)(policies.exhaustion_scale)
+node_quality = njit(cache=True)(policies.node_quality)
+
+NO_NODE = -1
+START, GOAL = 0, 1  # tree indices
+
+
+class Stop(enum.IntEnum):
+    """Why :func:`run` returned."""
+
+    BUDGET = 0  # ran its iterations
+    NEED_GOAL = 1  # the goal tree wants a goal state (fed by the caller, then GOAL_FED set)
+    NEED_ROOM = 2  # a tree or the record has less room than one iteration may need
+    CONNECTED = 3  # the trees connected: Slot.START_NODE, Slot.GOAL_NODE
+
+
+class Slot(enum.IntEnum):
+    """The loop's integer state (:attr:`Loop.ints`)."""
+
+    GREW_START = 0  # the tree the last iteration grew (1: start), kept across solves
+    STEPS = 1  # connect steps since the last swap, kept across solves
+    COLLIDED = 2  # the last connect ended trapped, kept across solves
+    ITERATIONS = 3
+    SWAPS = 4  # SWAPS + cause: swaps by policies.SwapCause (4 of them)
+    REJECTIONS = 8  # samples the sample policy discarded
+    NEXT_SAMPLE = 9  # next row of the block of uniform samples
+    GOAL_FED = 10  # the caller fed the goal this iteration asked for
+    SAMPLED_GOALS = 11  # PlannerInputStates::getSampledGoalsCount()
+    MORE_GOALS = 12  # PlannerInputStates::haveMoreGoalStates()
+    START_NODE = 13  # the connection, when CONNECTED
+    GOAL_NODE = 14
+    ROOM = 15  # nodes one iteration may add to a tree
+    START_COSTS = 16  # nodes whose neighbour-quality cost is known, per tree
+    GOAL_COSTS = 17
+    RECORDED = 18  # rows of the record in use
+    COUNT = 19
+
+
+class Real(enum.IntEnum):
+    """The loop's real-valued state (:attr:`Loop.reals`)."""
+
+    TREE_GAP = 0  # least distance between the trees seen after a connect ("approx goal distance")
+    START_COST_MAX = 1  # largest neighbour-quality cost per tree
+    GOAL_COST_MAX = 2
+    COUNT = 3
+
+
+class Record(enum.IntEnum):
+    """Columns of the loop record's integer rows (:attr:`Loop.record`); ``record_target`` holds the targets."""
+
+    ITERATION = 0
+    KIND = 1  # 0: the tree choice; 1: an extension step; 2: a connect step
+    GREW_START = 2  # choice: the tree grown before / step: the tree grown (1: start)
+    STEPS = 3  # choice: steps passed to the rule / step: the node extended
+    COLLIDED = 4  # choice: collided passed to the rule / step: the node was given (1) or looked up
+    CHOSEN = 5  # choice: the tree chosen (1: start) / step: the outcome (Grow)
+    CAUSE = 6  # choice: the swap cause (-1: no swap) / step: the node added (-1: none)
+    COUNT = 7
+
+
+class Settings(NamedTuple):
+    """The parameters of one solve (:class:`~ompl_balance.planners.RRTConnectSettings`, policies as indices)."""
+
+    range: float
+    intermediate_states: bool
+    step_may_stall: bool
+    balance_tree_sizes: bool
+    max_tree_size_ratio: float
+    swap_policy: int  # index in policies.SWAP_POLICIES
+    swap_steps: int
+    nearest_policy: int  # index in policies.NEAREST_POLICIES
+    exhausted_after: int
+    exhaustion_target: int
+    sample_policy: int  # index in policies.SAMPLE_POLICIES
+    goal_bias: float
+    uniform_rate: float
+    min_quality: float
+    record: bool  # fill Loop.record
+
+
+class Tree(NamedTuple):
+    """One tree's arrays (capacity rows): states (capacity, dim), parents, roots, failed
+    extensions per node, and neighbour-quality costs."""
+
+    states: np.ndarray
+    parents: np.ndarray
+    roots: np.ndarray
+    failures: np.ndarray
+    costs: np.ndarray
+
+
+class Loop(NamedTuple):
+    """Everything :func:`run` reads and changes, owned by the caller.
+
+    ``sizes`` (2,): nodes in the start and goal tree. ``ints`` (:class:`Slot`) and ``reals``
+    (:class:`Real`): the loop's state. ``block`` (256, dim) uniform samples, refilled from
+    ``uniforms`` (256, draws). ``step`` (dim,) and ``target`` (dim,): scratch. ``record``
+    (rows, :class:`Record`) and ``record_target`` (rows, dim): what each iteration did.
+    """
+
+    sizes: np.ndarray
+    ints: np.ndarray
+    reals: np.ndarray
+    block: np.ndarray
+    uniforms: np.ndarray
+    step: np.ndarray
+    target: np.ndarray
+    record: np.ndarray
+    record_target: np.ndarray
+
+
+_EUCLIDEAN, _EXHAUSTED, _EXHAUSTION = (policies.NEAREST_POLICIES.index(name) for name in policies.NEAREST_POLICIES)
+_UNIFORM, _GOAL_BIAS, _GOAL_BALL, _QUALITY = (
+    policies.SAMPLE_POLICIES.index(name) for name in ("uniform", "goal_bias", "goal_ball", "neighbour_quality")
+)
+_SAMPLE_ATTEMPTS = policies.SAMPLE_ATTEMPTS
+_TRAPPED, _ADVANCED, _REACHED = int(Grow.TRAPPED), int(Grow.ADVANCED), int(Grow.REACHED)
+
+
+@njit(cache=True)
+def _uniform(layout: SpaceLayout, loop: Loop, rng: Any) -> np.ndarray:  # pragma: no cover (compiled)
+    """The next uniform sample (a row of the block, refilled as the Python engine refills its own)."""
+    if loop.ints[Slot.NEXT_SAMPLE] == loop.block.shape[0]:
+        for row in range(loop.uniforms.shape[0]):
+            for k in range(loop.uniforms.shape[1]):
+                loop.uniforms[row, k] = rng.random()
+        for row in range(loop.block.shape[0]):
+            sample_from_uniforms(layout, loop.uniforms[row], loop.block[row])
+        loop.ints[Slot.NEXT_SAMPLE] = 0
+    row = loop.ints[Slot.NEXT_SAMPLE]
+    loop.ints[Slot.NEXT_SAMPLE] = row + 1
+    return loop.block[row]
+
+
+@njit(cache=True)
+def _find_nearest(
+    settings: Settings, layout: SpaceLayout, tree: Tree, size: int, target: np.ndarray
+) -> tuple[int, float]:  # pragma: no cover (compiled)
+    """The node the nearest policy extends towards ``target``, and its distance (first on ties)."""
+    if settings.nearest_policy != _EXHAUSTION:
+        node, best = nearest(layout, tree.states, size, target)
+        if settings.nearest_policy == _EUCLIDEAN or tree.failures[node] < settings.exhausted_after:
+            return node, best  # the nearest of all is not exhausted: no need to rank
+    found, found_distance, score = NO_NODE, np.inf, np.inf
+    closest, closest_distance = 0, np.inf
+    for i in range(size):
+        d = distance(layout, tree.states[i], target)
+        if d < closest_distance:
+            closest, closest_distance = i, d
+        if settings.nearest_policy == _EXHAUSTED:
+            if tree.failures[i] < settings.exhausted_after and d < found_distance:
+                found, found_distance = i, d
+        else:
+            scaled = d * exhaustion_scale(tree.failures[i], settings.exhaustion_target)
+            if scaled < score:
+                found, found_distance, score = i, d, scaled
+    return (found, found_distance) if found != NO_NODE else (closest, closest_distance)
+
+
+@njit(cache=True)
+def _add(tree: Tree, size: int, state: np.ndarray, parent: int) -> None:  # pragma: no cover (compiled)
+    tree.states[size] = state
+    tree.parents[size] = parent
+    tree.roots[size] = size if parent == NO_NODE else tree.roots[parent]
+    tree.failures[size] = 0
+
+
+@njit(cache=True)
+def _note(loop: Loop, iteration: int, kind: int, a: int, b: int, c: int, d: int, e: int) -> int:  # pragma: no cover
+    """Append a row to the loop record (columns of :class:`Record`); returns its index."""
+    row = loop.ints[Slot.RECORDED]
+    loop.record[row, Record.ITERATION], loop.record[row, Record.KIND] = iteration, kind
+    loop.record[row, Record.GREW_START], loop.record[row, Record.STEPS] = a, b
+    loop.record[row, Record.COLLIDED], loop.record[row, Record.CHOSEN], loop.record[row, Record.CAUSE] = c, d, e
+    loop.ints[Slot.RECORDED] = row + 1
+    return row
+
+
+@njit(cache=True)
+def _grow(
+    checks: Any,
+    layout: SpaceLayout,
+    settings: Settings,
+    trees: tuple[Tree, Tree],
+    loop: Loop,
+    t: int,
+    target: np.ndarray,
+    given: int,
+    kind: int,
+) -> tuple[int, int, float]:  # pragma: no cover (compiled)
+    """Grow tree ``t`` one step towards ``target`` from node ``given`` (``NO_NODE``: the nearest
+    policy's node). Returns the outcome (:class:`Grow`), the node added and the distance from the
+    node extended to ``target``. As the Python engine's ``Extender.grow``: motions in the start tree
+    run outwards, in the goal tree from the new state in (the new state checked first)."""
+    tree, size = trees[t], loop.sizes[t]
+    if given == NO_NODE:
+        node, gap = _find_nearest(settings, layout, tree, size, target)
+    else:
+        node, gap = given, distance(layout, tree.states[given], target)
+    near = tree.states[node]
+    reach = gap <= settings.range
+    if reach:
+        new = target
+    else:
+        interpolate(layout, near, target, settings.range / gap, loop.step)
+        new = loop.step
+    outcome, added = _TRAPPED, NO_NODE
+    if reach or not (settings.step_may_stall and equal(layout, near, new)):
+        if t == START:
+            valid = motion_free(checks, near, new)
+        else:
+            valid = state_free(checks, new) and motion_free(checks, new, near)
+        if not valid:
+            if settings.nearest_policy != _EUCLIDEAN:
+                tree.failures[node] += 1
+        else:
+            added = node
+            if settings.intermediate_states:
+                # the states along the motion, ordered away from the tree's root
+                count = segment_count(layout, near, new)
+                for step in range(1, count):
+                    interpolate(layout, near, new, step / count, loop.target)
+                    _add(tree, loop.sizes[t], loop.target, added)
+                    added = loop.sizes[t]
+                    loop.sizes[t] += 1
+            _add(tree, loop.sizes[t], new, added)
+            added = loop.sizes[t]
+            loop.sizes[t] += 1
+            outcome = _REACHED if reach else _ADVANCED
+    if settings.record:
+        row = _note(loop, loop.ints[Slot.ITERATIONS], kind, 1 - t, node, int(given != NO_NODE), outcome, added)
+        loop.record_target[row] = target
+    return outcome, added, gap
+
+
+@njit(cache=True)
+def _update_costs(layout: SpaceLayout, trees: tuple[Tree, Tree], loop: Loop, t: int) -> None:  # pragma: no cover
+    """Neighbour-quality costs ``d(start, node) + d(node, goal)`` of tree ``t``'s new nodes."""
+    start, goal = trees[START].states[0], trees[GOAL].states[0]
+    tree = trees[t]
+    largest = loop.reals[Real.START_COST_MAX + t]
+    for node in range(loop.ints[Slot.START_COSTS + t], loop.sizes[t]):
+        point = tree.states[node]
+        cost = distance(layout, start, point) + distance(layout, point, goal)
+        tree.costs[node] = cost
+        largest = max(largest, cost)
+    loop.reals[Real.START_COST_MAX + t] = largest
+    loop.ints[Slot.START_COSTS + t] = loop.sizes[t]
+
+
+@njit(cache=True)
+def _target(
+    layout: SpaceLayout, settings: Settings, trees: tuple[Tree, Tree], loop: Loop, rng: Any, t: int
+) -> tuple[np.ndarray, int, bool]:  # pragma: no cover (compiled)
+    """The iteration's target (a row of ``loop.block`` or of a tree), the node to extend when
+    the policy found it (``NO_NODE``: look it up), and ``False`` when the policy gave up."""
+    policy = settings.sample_policy
+    if policy == _UNIFORM:
+        return _uniform(layout, loop, rng), NO_NODE, True
+    other = trees[1 - t]
+    if policy == _GOAL_BIAS:
+        if rng.random() < settings.goal_bias:
+            return other.states[0], NO_NODE, True
+        return _uniform(layout, loop, rng), NO_NODE, True
+    # goal_ball and neighbour_quality: uniform targets at uniform_rate keep them complete
+    if settings.uniform_rate > 0.0 and rng.random() < settings.uniform_rate:
+        return _uniform(layout, loop, rng), NO_NODE, True
+    start, goal = trees[START].states[0], trees[GOAL].states[0]
+    if policy == _GOAL_BALL:
+        centre = other.states[0]
+        radius = distance(layout, start, goal)
+        for _ in range(_SAMPLE_ATTEMPTS):
+            point = _uniform(layout, loop, rng)
+            if distance(layout, point, centre) <= radius:
+                return point, NO_NODE, True
+            loop.ints[Slot.REJECTIONS] += 1
+        return loop.target, NO_NODE, False
+    _update_costs(layout, trees, loop, t)
+    tree = trees[t]
+    optimal = distance(layout, start, goal)
+    for _ in range(_SAMPLE_ATTEMPTS):
+        point = _uniform(layout, loop, rng)
+        node, _gap = _find_nearest(settings, layout, tree, loop.sizes[t], point)
+        quality = node_quality(tree.costs[node], optimal, loop.reals[Real.START_COST_MAX + t], settings.min_quality)
+        if rng.random() < quality:
+            return point, node, True
+        loop.ints[Slot.REJECTIONS] += 1
+    return loop.target, NO_NODE, False
+
+
+@njit(cache=True)
+def run(
+    checks: Any,
+    layout: SpaceLayout,
+    settings: Settings,
+    trees: tuple[Tree, Tree],
+    loop: Loop,
+    rng: Any,
+    budget: int,
+) -> int:  # pragma: no cover (compiled)
+    """Run at most ``budget`` iterations of the loop; returns why it stopped (:class:`Stop`)."""
+    ints, sizes = loop.ints, loop.sizes
+    room = ints[Slot.ROOM]
+    for _ in range(budget):
+        if ints[Slot.GOAL_FED] == 0:
+            for t in range(2):
+                if trees[t].parents.shape[0] - sizes[t] < room:
+                    return Stop.NEED_ROOM
+            if settings.record and loop.record.shape[0] - ints[Slot.RECORDED] < room + 2:
+                return Stop.NEED_ROOM
+            # goal states join the goal tree while fewer than half of its states were sampled
+            if sizes[GOAL] == 0 or (ints[Slot.MORE_GOALS] != 0 and ints[Slot.SAMPLED_GOALS] < sizes[GOAL] // 2):
+                return Stop.NEED_GOAL
+        ints[Slot.GOAL_FED] = 0
+        ints[Slot.ITERATIONS] += 1
+        iteration = ints[Slot.ITERATIONS]
+
+        grew_start = ints[Slot.GREW_START] != 0
+        steps, collided = ints[Slot.STEPS], ints[Slot.COLLIDED] != 0
+        grow_start, swap_cause = choose_tree(
+            settings.swap_policy,
+            settings.balance_tree_sizes,
+            settings.max_tree_size_ratio,
+            settings.swap_steps,
+            grew_start,
+            sizes[START],
+            sizes[GOAL],
+            steps,
+            collided,
+        )
+        cause = swap_cause.value
+        swapped = grow_start != grew_start
+        if swapped:
+            ints[Slot.STEPS], ints[Slot.COLLIDED] = 0, 0
+            if iteration > 1:
+                ints[Slot.SWAPS + cause] += 1
+        if settings.record:
+            _note(loop, iteration, 0, int(grew_start), steps, int(collided), int(grow_start), cause if swapped else -1)
+        ints[Slot.GREW_START] = 1 if grow_start else 0
+        t = START if grow_start else GOAL
+        o = 1 - t
+
+        target, given, found = _target(layout, settings, trees, loop, rng, t)
+        if not found:
+            continue
+        grown, added, _gap = _grow(checks, layout, settings, trees, loop, t, target, given, 1)
+        if grown == _TRAPPED:
+            continue
+        # connect: walk the other tree towards the state just added until trapped or there
+        reach = trees[t].states[added]  # stays put: only the other tree grows while connecting
+        connected, reached, gap = _grow(checks, layout, settings, trees, loop, o, reach, NO_NODE, 2)
+        ints[Slot.STEPS] += 1
+        while connected == _ADVANCED:
+            connected, reached, gap = _grow(checks, layout, settings, trees, loop, o, reach, reached, 2)
+            ints[Slot.STEPS] += 1
+        # OMPL's "approx goal distance": the other tree's nearest node to the state just added
+        if connected == _REACHED:
+            gap = 0.0
+        elif settings.nearest_policy != _EUCLIDEAN:
+            gap = nearest(layout, trees[o].states, sizes[o], reach)[1]
+        loop.reals[Real.TREE_GAP] = min(loop.reals[Real.TREE_GAP], gap)
+        collided = connected == _TRAPPED
+        ints[Slot.COLLIDED] = 1 if collided else 0
+        if collided:
+            continue
+        ints[Slot.START_NODE], ints[Slot.GOAL_NODE] = (added, reached) if grow_start else (reached, added)
+        return Stop.CONNECTED
+    return Stop.BUDGET

@@ -1,0 +1,79 @@
+"""One solve of an RRT-Connect planner, as both engines see it.
+
+:class:`Solve` holds what the planner hands an engine for one ``solve()``: the trees and
+what its policies keep across solves, this solve's policies and settings, the planner
+input states and the goal, and what the engine reports back (counts, the gap between the
+trees, the record). Goal feeding and the acceptance of a connection are the same for both
+engines, so they live here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from ompl import base as ob
+from ompl import util as ou
+
+from ..core.planner import Progress
+from ..core.spaces import Points
+from ..core.trees import Tree
+from ..policies import NearestChoice, NodeFailures, SampleContext, SamplerCounts, TargetChoice, TreeChoice
+from .events import LoopCounts, LoopRecord
+
+
+@dataclass
+class Solve:
+    """What one solve's loop works with (see the module docstring)."""
+
+    name: str  # the planner's name, for OMPL's messages
+    si: ob.SpaceInformation
+    points: Points
+    settings: Any  # the planner's RRTConnectSettings
+    start_tree: Tree
+    goal_tree: Tree
+    failures: dict[Tree, NodeFailures]  # per tree, kept across solves
+    tree_choice: TreeChoice
+    nearest: NearestChoice
+    targets: TargetChoice
+    sample_context: SampleContext
+    inputs: ob.PlannerInputStates
+    goal: ob.GoalSampleableRegion
+    progress: Progress
+    rng: np.random.Generator  # the solve's random numbers (the targets' samples and draws)
+    record: LoopRecord | None = None
+    counts: LoopCounts = field(default_factory=LoopCounts)
+    tree_gap: float = float("inf")  # least distance between the trees seen after a connect
+    connection: tuple[int, int] | None = None  # (start node, goal node) of the accepted connection
+
+    @property
+    def sampler_counts(self) -> SamplerCounts:
+        return self.sample_context.counts
+
+    def wants_goal(self) -> bool:
+        """OMPL's rule: goal states join the goal tree while fewer than half of its states were sampled."""
+        return len(self.goal_tree) == 0 or self.inputs.getSampledGoalsCount() < len(self.goal_tree) // 2
+
+    def feed_goal(self, ptc: ob.PlannerTerminationCondition) -> bool:
+        """Add the next goal state to the goal tree (waiting for one within ``ptc`` while it is
+        empty); ``False`` when the goal tree is still empty (no valid goal state)."""
+        empty = len(self.goal_tree) == 0
+        state = self.inputs.nextGoal(ptc) if empty else self.inputs.nextGoal()
+        if state is not None and self.points.is_finite(state):
+            self.goal_tree.add(self.points.from_state(state))
+        if len(self.goal_tree) == 0:
+            ou.OMPL_ERROR(f"{self.name}: Unable to sample any valid states for goal tree")
+            return False
+        return True
+
+    def accept(self, start_node: int, goal_node: int) -> bool:
+        """Whether the goal takes the trees' roots of this connection as a start-goal pair
+        (``isStartGoalPairValid``); records it if so."""
+        points = self.points
+        start_root = points.ompl_state(self.start_tree.state(self.start_tree.root(start_node)), 0)
+        goal_root = points.ompl_state(self.goal_tree.state(self.goal_tree.root(goal_node)), 1)
+        if self.goal.isStartGoalPairValid(start_root, goal_root):
+            self.connection = (start_node, goal_node)
+            return True
+        return False
