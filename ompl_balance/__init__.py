@@ -47,7 +47,15 @@ from .planners import (
     RunStats,
     SwapLimitRRTConnect,
 )
-from .policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause, balance_choice, choose_tree
+from .policies import (
+    NEAREST_POLICIES,
+    SAMPLE_POLICIES,
+    SWAP_POLICIES,
+    SwapCause,
+    balance_choice,
+    choose_tree,
+    tree_size_ratio,
+)
 from .rrtstar import BallRadiusRRTstar, RRTstarStats
 from .samplers import BridgeTestValidStateSampler, GaussianValidStateSampler, PassageSampler
 from .worlds.boxes import PROBLEMS, BoxWorld2D, Problem, get_problem
@@ -151,6 +159,7 @@ __all__ = [
     "rewire_radius",
     "rooms_grid",
     "rooms_problem",
+    "tree_size_ratio",
     "unit_ball_volume",
 ]
 

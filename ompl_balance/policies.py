@@ -68,6 +68,15 @@ def _choice(name: str, value: str, accepted: tuple[str, ...]) -> int:
 # -- swap_policy and balancing -------------------------------------------------------------
 
 
+def tree_size_ratio(start_size: int, goal_size: int) -> float:
+    """``|a - b| / min(a, b)``: how much larger the larger tree is, relative to the smaller.
+
+    Dividing by the *smaller* size is what makes the rule engage: with ``max(a, b)`` in
+    the denominator (the first OMPL pull request) the ratio never reaches 1.
+    """
+    return abs(start_size - goal_size) / min(start_size, goal_size)
+
+
 def choose_tree(
     swap_policy: int,
     balance_tree_sizes: bool,
@@ -84,21 +93,15 @@ def choose_tree(
     Given which tree the previous iteration grew (``grew_start``), the tree sizes, the
     connect steps taken since the last swap and whether the last connect ended in a
     collision. The balancing rule first: with ``balance_tree_sizes`` and trees of different
-    sizes ``a``, ``b``, when ``|a - b| / min(a, b) >= max_tree_size_ratio`` the smaller tree
-    grows. Dividing by the *smaller* size is what makes the rule engage: with ``max(a, b)``
-    in the denominator (the first OMPL pull request) the ratio never reaches 1. Otherwise
-    ``swap_policy`` (an index into :data:`SWAP_POLICIES`) decides:
+    sizes, when :func:`tree_size_ratio` reaches ``max_tree_size_ratio`` the smaller tree
+    grows. Otherwise ``swap_policy`` (an index into :data:`SWAP_POLICIES`) decides:
 
     ``alternate``      the other tree, every iteration (stock RRT-Connect);
     ``balance_steps``  the same tree until ``swap_steps`` connect steps were taken since
                        the last swap, then the other (the swap limiter);
     ``on_collision``   the same tree until a connect ends in a collision, then the other.
     """
-    if (
-        balance_tree_sizes
-        and start_size != goal_size
-        and abs(start_size - goal_size) / min(start_size, goal_size) >= max_tree_size_ratio
-    ):
+    if balance_tree_sizes and start_size != goal_size and tree_size_ratio(start_size, goal_size) >= max_tree_size_ratio:
         return start_size < goal_size, SwapCause.BALANCE
     if swap_policy == 0:
         return not grew_start, SwapCause.ALTERNATE

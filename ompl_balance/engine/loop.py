@@ -23,6 +23,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 
 from .. import policies
 from ..core.checks import motion_free, state_free
@@ -30,6 +31,7 @@ from ..core.compiled_spaces import distance, equal, interpolate, nearest, sample
 from ..core.layout import SpaceLayout
 from .events import Grow
 
+register_jitable(policies.tree_size_ratio)  # callable from the compiled choose_tree
 choose_tree = njit(cache=True)(policies.choose_tree)
 exhaustion_scale = njit(cache=True)(policies.exhaustion_scale)
 node_quality = njit(cache=True)(policies.node_quality)
@@ -148,6 +150,7 @@ _UNIFORM, _GOAL_BIAS, _GOAL_BALL, _QUALITY = (
 )
 _SAMPLE_ATTEMPTS = policies.SAMPLE_ATTEMPTS
 _TRAPPED, _ADVANCED, _REACHED = int(Grow.TRAPPED), int(Grow.ADVANCED), int(Grow.REACHED)
+_CHOICE, _EXTENSION, _CONNECT_STEP = 0, 1, 2  # kinds of row in the loop record
 
 
 @njit(cache=True)
@@ -191,8 +194,15 @@ def _find_nearest(
 
 
 @njit(cache=True)
+def _copy(source: np.ndarray, destination: np.ndarray) -> None:  # pragma: no cover (compiled)
+    """``destination[:] = source`` as a loop (an array assignment compiles its shape checks' messages)."""
+    for k in range(source.shape[0]):
+        destination[k] = source[k]
+
+
+@njit(cache=True)
 def _add(tree: Tree, size: int, state: np.ndarray, parent: int) -> None:  # pragma: no cover (compiled)
-    tree.states[size] = state
+    _copy(state, tree.states[size])
     tree.parents[size] = parent
     tree.roots[size] = size if parent == NO_NODE else tree.roots[parent]
     tree.failures[size] = 0
@@ -210,7 +220,24 @@ def _note(loop: Loop, iteration: int, kind: int, a: int, b: int, c: int, d: int,
 
 
 @njit(cache=True)
-def _grow(
+def _node_towards(
+    settings: Settings,
+    layout: SpaceLayout,
+    trees: tuple[Tree, Tree],
+    loop: Loop,
+    t: int,
+    target: np.ndarray,
+    given: int,
+) -> tuple[int, float]:  # pragma: no cover (compiled)
+    """The node of tree ``t`` to extend towards ``target``: ``given``, or the nearest policy's
+    (``given`` is ``NO_NODE``); and its distance to ``target``."""
+    if given == NO_NODE:
+        return _find_nearest(settings, layout, trees[t], loop.sizes[t], target)
+    return given, distance(layout, trees[t].states[given], target)
+
+
+@njit(cache=True)
+def _extend(
     checks: Any,
     layout: SpaceLayout,
     settings: Settings,
@@ -218,18 +245,17 @@ def _grow(
     loop: Loop,
     t: int,
     target: np.ndarray,
-    given: int,
-    kind: int,
-) -> tuple[int, int, float]:  # pragma: no cover (compiled)
-    """Grow tree ``t`` one step towards ``target`` from node ``given`` (``NO_NODE``: the nearest
-    policy's node). Returns the outcome (:class:`Grow`), the node added and the distance from the
-    node extended to ``target``. As the Python engine's ``Extender.grow``: motions in the start tree
-    run outwards, in the goal tree from the new state in (the new state checked first)."""
-    tree, size = trees[t], loop.sizes[t]
-    if given == NO_NODE:
-        node, gap = _find_nearest(settings, layout, tree, size, target)
-    else:
-        node, gap = given, distance(layout, tree.states[given], target)
+    node: int,
+    gap: float,
+) -> tuple[int, int]:  # pragma: no cover (compiled)
+    """Extend tree ``t`` one step from ``node`` (``gap`` from ``target``) towards ``target``.
+
+    Returns the outcome (:class:`~ompl_balance.engine.events.Grow`) and the node added. As the
+    Python engine's ``Extender``: motions in the start tree run outwards, in the goal tree from
+    the new state in (the new state checked first); a motion in collision counts as a failed
+    extension of ``node`` for the nearest policies that count failures.
+    """
+    tree = trees[t]
     near = tree.states[node]
     reach = gap <= settings.range
     if reach:
@@ -237,33 +263,37 @@ def _grow(
     else:
         interpolate(layout, near, target, settings.range / gap, loop.step)
         new = loop.step
-    outcome, added = _TRAPPED, NO_NODE
-    if reach or not (settings.step_may_stall and equal(layout, near, new)):
-        if t == START:
-            valid = motion_free(checks, near, new)
-        else:
-            valid = state_free(checks, new) and motion_free(checks, new, near)
-        if not valid:
-            if settings.nearest_policy != _EUCLIDEAN:
-                tree.failures[node] += 1
-        else:
-            added = node
-            if settings.intermediate_states:
-                # the states along the motion, ordered away from the tree's root
-                count = segment_count(layout, near, new)
-                for step in range(1, count):
-                    interpolate(layout, near, new, step / count, loop.target)
-                    _add(tree, loop.sizes[t], loop.target, added)
-                    added = loop.sizes[t]
-                    loop.sizes[t] += 1
-            _add(tree, loop.sizes[t], new, added)
+        if settings.step_may_stall and equal(layout, near, new):
+            return _TRAPPED, NO_NODE
+    if t == START:  # noqa: SIM108 (the two directions read as OMPL writes them)
+        valid = motion_free(checks, near, new)
+    else:
+        valid = state_free(checks, new) and motion_free(checks, new, near)
+    if not valid:
+        if settings.nearest_policy != _EUCLIDEAN:
+            tree.failures[node] += 1
+        return _TRAPPED, NO_NODE
+    added = node
+    if settings.intermediate_states:
+        # the states along the motion, ordered away from the tree's root
+        count = segment_count(layout, near, new)
+        for step in range(1, count):
+            interpolate(layout, near, new, step / count, loop.target)
+            _add(tree, loop.sizes[t], loop.target, added)
             added = loop.sizes[t]
             loop.sizes[t] += 1
-            outcome = _REACHED if reach else _ADVANCED
-    if settings.record:
-        row = _note(loop, loop.ints[Slot.ITERATIONS], kind, 1 - t, node, int(given != NO_NODE), outcome, added)
-        loop.record_target[row] = target
-    return outcome, added, gap
+    _add(tree, loop.sizes[t], new, added)
+    added = loop.sizes[t]
+    loop.sizes[t] += 1
+    return (_REACHED if reach else _ADVANCED), added
+
+
+@njit(cache=True)
+def _note_step(
+    loop: Loop, kind: int, t: int, node: int, given: int, outcome: int, added: int, target: np.ndarray
+) -> None:  # pragma: no cover (compiled)
+    row = _note(loop, loop.ints[Slot.ITERATIONS], kind, 1 - t, node, int(given != NO_NODE), outcome, added)
+    _copy(target, loop.record_target[row])
 
 
 @njit(cache=True)
@@ -368,7 +398,16 @@ def run(
             if iteration > 1:
                 ints[Slot.SWAPS + cause] += 1
         if settings.record:
-            _note(loop, iteration, 0, int(grew_start), steps, int(collided), int(grow_start), cause if swapped else -1)
+            _note(
+                loop,
+                iteration,
+                _CHOICE,
+                int(grew_start),
+                steps,
+                int(collided),
+                int(grow_start),
+                cause if swapped else -1,
+            )
         ints[Slot.GREW_START] = 1 if grow_start else 0
         t = START if grow_start else GOAL
         o = 1 - t
@@ -376,16 +415,23 @@ def run(
         target, given, found = _target(layout, settings, trees, loop, rng, t)
         if not found:
             continue
-        grown, added, _gap = _grow(checks, layout, settings, trees, loop, t, target, given, 1)
+        node, gap = _node_towards(settings, layout, trees, loop, t, target, given)
+        grown, added = _extend(checks, layout, settings, trees, loop, t, target, node, gap)
+        if settings.record:
+            _note_step(loop, _EXTENSION, t, node, given, grown, added, target)
         if grown == _TRAPPED:
             continue
-        # connect: walk the other tree towards the state just added until trapped or there
+        # connect: walk the other tree towards the state just added until trapped or there;
+        # each further step extends the node just added (see policies.nearest_choice)
         reach = trees[t].states[added]  # stays put: only the other tree grows while connecting
-        connected, reached, gap = _grow(checks, layout, settings, trees, loop, o, reach, NO_NODE, 2)
-        ints[Slot.STEPS] += 1
+        connected, reached, given = _ADVANCED, NO_NODE, NO_NODE
         while connected == _ADVANCED:
-            connected, reached, gap = _grow(checks, layout, settings, trees, loop, o, reach, reached, 2)
+            node, gap = _node_towards(settings, layout, trees, loop, o, reach, given)
+            connected, reached = _extend(checks, layout, settings, trees, loop, o, reach, node, gap)
+            if settings.record:
+                _note_step(loop, _CONNECT_STEP, o, node, given, connected, reached, reach)
             ints[Slot.STEPS] += 1
+            given = reached
         # OMPL's "approx goal distance": the other tree's nearest node to the state just added
         if connected == _REACHED:
             gap = 0.0
