@@ -17,8 +17,8 @@ planner made them do.
 
 from __future__ import annotations
 
-import functools
 import math
+from typing import Any
 
 import numpy as np
 from ompl import base as ob
@@ -26,7 +26,15 @@ from ompl import geometric as og
 
 from .collision.certified import MotionCertifier, PathCertificate, certify_states
 from .collision.checker import CollisionChecker
+from .collision.kernels import (
+    CertifiedMotions,
+    RobotDiscreteMotions,
+    robot_discrete_motion_free,
+    robot_discrete_motions,
+)
 from .collision.kinematics import RobotModel
+from .collision.screening import entry_point
+from .core.layout import layout_for
 
 #: The motion validators :func:`setup_robot` installs, by name.
 MOTION_VALIDATORS = ("certified", "discrete")
@@ -55,7 +63,12 @@ class StateValidityChecker(ob.StateValidityChecker):
         self._dof = checker.robot.dof
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
+        """Collision-free, within the joint limits, and finite (``False``, not an exception, otherwise)."""
         return self.checker.is_valid(state[0 : self._dof])
+
+    def compiled_view(self) -> Any:
+        """The checker's view for compiled code (:class:`~ompl_balance.collision.kernels.RobotStates`)."""
+        return self.checker.kernel_view()
 
     def counters(self) -> dict[str, int]:
         return self.checker.counters()
@@ -100,15 +113,34 @@ class MotionValidator(_RobotMotionValidator):
     ``s2``, the midpoint, the quarter points, ...: ``s2`` alone first on the single-state
     path (it decides most colliding edges, as in OMPL's validator), then all the others in
     one batch of forward kinematics and pre-filter, FCL running on them in that order until
-    the first collision. Counts one motion and the states of the batches processed.
+    the first collision (:func:`~ompl_balance.collision.kernels.coarse_to_fine`). Counts one
+    motion and the states of the batches processed.
     """
 
     def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker):
         super().__init__(si, checker)
         self._space = si.getStateSpace()
+        self._view: RobotDiscreteMotions | None = None
+        self._segments: tuple[float, int] | None = None  # the space's valid segment length and factor for _view
+        self._motion_free: Any = None
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         return self.check_motion_last_valid(s1, s2)[0]
+
+    def compiled_view(self) -> RobotDiscreteMotions:
+        """The validator as compiled code sees it (:class:`~ompl_balance.collision.kernels.RobotDiscreteMotions`),
+        for the space's current validity-checking resolution."""
+        space = self._space
+        segments = (space.getLongestValidSegmentLength(), space.getValidSegmentCountFactor())
+        if self._view is None or segments != self._segments:
+            layout = layout_for(space)
+            assert layout is not None  # a real-vector space (checked at construction)
+            rows = int(segments[1]) * math.ceil(space.getMaximumExtent() / segments[0])
+            self._view = robot_discrete_motions(self.checker, layout, rows)
+            self._segments = segments
+            lower = np.ascontiguousarray(self.checker.robot.lower, dtype=float)
+            self._motion_free = entry_point(robot_discrete_motion_free, (self._view, lower, lower))
+        return self._view
 
     def check_motion_last_valid(
         self, s1: ob.State, s2: ob.State, last_valid: ob.State | None = None
@@ -119,57 +151,29 @@ class MotionValidator(_RobotMotionValidator):
         binding does not expose): on a collision the states are examined in order from
         ``s1``, ``t = (j - 1) / nd`` for the first invalid state ``j``, and ``last_valid``
         (if given) is set to the state at ``t``. ``t = 1`` for a valid edge, and whenever
-        ``last_valid`` is not given (then the states are visited coarse to fine instead).
+        ``last_valid`` is not given (then the states are visited coarse to fine instead,
+        by the compiled kernel :func:`~ompl_balance.collision.kernels.robot_discrete_motion_free`).
         A state with a non-finite value makes the edge invalid with ``t = 0`` (``last_valid``
         is then ``s1``).
         """
-        self.checker.counter.motions_checked += 1
-        values = s2[0 : self._dof]
-        b = np.array(values)
-        if not math.isfinite(sum(values)):
+        a, b = np.array(s1[0 : self._dof]), np.array(s2[0 : self._dof])
+        if not (np.isfinite(a).all() and np.isfinite(b).all()):
             # invalid, not an exception through OMPL's C++ caller
-            self._set_last_valid(last_valid, np.array(s1[0 : self._dof]), b, 0.0)
-            return False, 0.0
-        if last_valid is None and not self.checker.is_valid(b):
-            # s2 alone on the single-state path first: it decides most colliding edges
-            return False, 1.0
-        values = s1[0 : self._dof]
-        a = np.array(values)
-        if not math.isfinite(sum(values)):
+            self.checker.counter.motions_checked += 1
             self._set_last_valid(last_valid, a, b, 0.0)
             return False, 0.0
+        if last_valid is None:
+            view = self.compiled_view()
+            return bool(self._motion_free(view, a, b)), 1.0
+        self.checker.counter.motions_checked += 1
         nd = self._space.validSegmentCount(s1, s2)
         t = np.arange(1, nd + 1) / nd
-        if last_valid is None:
-            states = a + t[:-1, None] * (b - a)
-            return nd == 1 or self.checker.first_collision(states, coarse_to_fine(nd)[1:], first_chunk=0) < 0, 1.0
-        states = a + t[:, None] * (b - a)
-        first = self.checker.first_collision(states)
+        first = self.checker.first_collision(a + t[:, None] * (b - a))
         if first < 0:
             return True, 1.0
         fraction = first / nd
         self._set_last_valid(last_valid, a, b, fraction)
         return False, fraction
-
-
-@functools.lru_cache(maxsize=4096)
-def coarse_to_fine(nd: int) -> tuple[int, ...]:
-    """Visiting order of the states ``j / nd``, ``j = 1 .. nd`` (as indices ``j - 1``).
-
-    The end state first, then breadth-first bisection of ``(0, nd)``: the midpoint, the
-    quarter points, and so on, so that an obstacle across the edge is met early. Cached:
-    planners ask for the same few lengths again and again.
-    """
-    order = [nd - 1]
-    intervals = [(0, nd)]
-    while intervals:
-        low, high = intervals.pop(0)
-        if high - low < 2:
-            continue
-        mid = (low + high) // 2
-        order.append(mid - 1)
-        intervals += [(low, mid), (mid, high)]
-    return tuple(order)
 
 
 class CertifiedMotionValidator(_RobotMotionValidator):
@@ -197,6 +201,10 @@ class CertifiedMotionValidator(_RobotMotionValidator):
     def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker, clearance: float = 0.0):
         super().__init__(si, checker)
         self.certifier = MotionCertifier(checker, clearance)
+
+    def compiled_view(self) -> CertifiedMotions:
+        """The validator as compiled code sees it (:class:`~ompl_balance.collision.kernels.CertifiedMotions`)."""
+        return self.certifier.compiled_view()
 
     @property
     def clearance(self) -> float:

@@ -10,12 +10,14 @@ import yourdfpy
 from ompl import base as ob
 from ompl import geometric as og
 
+from ompl_balance import BalancedRRTConnect
 from ompl_balance.collision.checker import CollisionChecker
 from ompl_balance.collision.environment import Environment
+from ompl_balance.collision.kernels import coarse_to_fine
 from ompl_balance.collision.kinematics import RobotModel
 from ompl_balance.collision.robots import PANDA_VAMP_DIR, load_panda_vamp
 from ompl_balance.core.counting import read_work
-from ompl_balance.validity import MotionValidator, StateValidityChecker, coarse_to_fine, setup_robot, space_for
+from ompl_balance.validity import MotionValidator, StateValidityChecker, setup_robot, space_for
 from ompl_balance.worlds.mbm import load_mbm
 
 ROBOTS = Path(__file__).resolve().parent / "robots"
@@ -199,11 +201,17 @@ def test_motion_validator_matches_discrete_panda():
     check_motion_validator(robot, environment, 40, seed=4)
 
 
+def visiting_order(nd):
+    order, intervals = np.zeros(nd + 1, dtype=np.int64), np.zeros((2 * nd + 2, 2), dtype=np.int64)
+    coarse_to_fine(nd, order, intervals)
+    return tuple(order[:nd].tolist())
+
+
 def test_coarse_to_fine_visits_every_state_once():
     for nd in range(1, 40):
-        order = coarse_to_fine(nd)
+        order = visiting_order(nd)
         assert sorted(order) == list(range(nd)) and order[0] == nd - 1
-    assert coarse_to_fine(8)[:4] == (7, 3, 1, 5)
+    assert visiting_order(8)[:4] == (7, 3, 1, 5)
 
 
 def test_space_bounds_and_planning_with_rrtconnect():
@@ -230,17 +238,45 @@ def test_space_bounds_and_planning_with_rrtconnect():
     assert work.motions_checked > 0 and work.states_checked > work.motions_checked
 
 
-def test_bad_input():
+def test_non_finite_and_out_of_limit_configurations_are_not_valid():
     robot, environment, _ = arm3_scene()
     checker = CollisionChecker(robot, environment)
-    with pytest.raises(ValueError, match="'slide'"):
-        checker.check([0.0, 0.0, np.inf])
+    free = next(q for q in np.random.default_rng(0).uniform(robot.lower, robot.upper, (100, 3)) if checker.is_valid(q))
+    outside = free.copy()
+    outside[1] = robot.upper[1] + 1e-9
+    rows = np.array([free, [0.0, 0.0, np.inf], [0.0, np.nan, 0.0], outside])
+    assert checker.check(rows).tolist() == [True, False, False, False]
+    assert [checker.is_valid(q) for q in rows] == [True, False, False, False]
     _space, si = make_si(robot, checker)
     validity = StateValidityChecker(si, checker)
     state = si.allocState()
-    state[0], state[1], state[2] = 0.0, float("nan"), 0.0
-    with pytest.raises(ValueError, match="'shoulder'"):
-        validity.isValid(state)
+    for q in rows:
+        for i in range(3):
+            state[i] = float(q[i])
+        assert validity.isValid(state) == checker.is_valid(q)
+
+
+@pytest.mark.parametrize("planner", [og.RRTConnect, BalancedRRTConnect])
+def test_a_non_finite_robot_start_is_an_invalid_start(planner):
+    robot, environment, _ = arm3_scene()
+    checker = CollisionChecker(robot, environment)
+    ss = og.SimpleSetup(space_for(robot))
+    setup_robot(ss, checker)
+    start, goal = ss.getSpaceInformation().allocState(), ss.getSpaceInformation().allocState()
+    for i in range(3):
+        start[i], goal[i] = 0.0, 0.0
+    start[1] = float("nan")
+    ss.setStartAndGoalStates(start, goal)
+    ss.setPlanner(planner(ss.getSpaceInformation()))
+    assert ss.solve(0.5) == ob.PlannerStatus.INVALID_START
+
+
+def test_bad_input():
+    robot, environment, _ = arm3_scene()
+    checker = CollisionChecker(robot, environment)
+    with pytest.raises(ValueError, match=r"shape \(n, 3\)"):
+        checker.check([0.0, 0.0])
+    _space, si = make_si(robot, checker)
     with pytest.raises(ValueError, match="dimension 2"):
         setup_robot(ob.SpaceInformation(ob.RealVectorStateSpace(2)), checker)
     with pytest.raises(ValueError, match="'wall'"):
@@ -251,8 +287,9 @@ def test_bad_input():
         environment.add_sphere("flat", 0.0)
     discrete = MotionValidator(si, checker)
     assert isinstance(discrete, ob.MotionValidator)
-    good = si.allocState()
+    good, state = si.allocState(), si.allocState()
     good[0], good[1], good[2] = 0.0, 0.0, 0.0
+    state[0], state[1], state[2] = 0.0, float("nan"), 0.0
     assert discrete.check_motion_last_valid(good, state) == (False, 0.0)  # NaN: invalid, no exception
     last = si.allocState()
     for end in (float("nan"), float("inf")):

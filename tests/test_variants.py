@@ -13,9 +13,9 @@ from ompl import tools as ot
 from ompl import util as ou
 from pathcheck import assert_valid_solution
 
-from ompl_balance import planners
 from ompl_balance.core.trees import ArrayTree
-from ompl_balance.planners import PRESETS, BalancedRRTConnect, Extender, GaussianPassageRRTConnect, Grow
+from ompl_balance.engine.events import Grow, LoopRecord
+from ompl_balance.planners import PRESETS, BalancedRRTConnect, GaussianPassageRRTConnect
 from ompl_balance.policies import (
     NEAREST_POLICIES,
     SAMPLE_ATTEMPTS,
@@ -25,14 +25,16 @@ from ompl_balance.policies import (
     SampleContext,
     SamplerCounts,
     SwapCause,
+    SwapState,
+    TreeChoice,
     balance_choice,
+    choose_tree,
     exhaustion_scale,
     nearest_by_exhaustion,
-    nearest_finder,
+    nearest_choice,
     nearest_not_exhausted,
     node_quality,
-    target_sampler,
-    tree_chooser,
+    target_choice,
 )
 from ompl_balance.samplers import GaussianValidStateSampler
 from ompl_balance.worlds.boxes import TWIN_POCKETS, circle_setup, get_problem
@@ -45,15 +47,35 @@ ou.setLogLevel(ou.LOG_WARN)
 # -- pure rules ---------------------------------------------------------------------------
 
 
+def tree_rule(swap_policy, balance_tree_sizes=False, max_tree_size_ratio=1.0, swap_steps=1):
+    """``choose(grew_start, start_size, goal_size, steps, collided)``: the compiled rule's inputs, named."""
+    index = SWAP_POLICIES.index(swap_policy)
+
+    def choose(grew_start, start_size, goal_size, steps, collided):
+        return choose_tree(
+            index,
+            balance_tree_sizes,
+            max_tree_size_ratio,
+            swap_steps,
+            grew_start,
+            start_size,
+            goal_size,
+            steps,
+            collided,
+        )
+
+    return choose
+
+
 @pytest.mark.parametrize("grew_start", [True, False])
 def test_alternate_always_swaps(grew_start):
-    choose = tree_chooser("alternate")
+    choose = tree_rule("alternate")
     for sizes, steps, collided in (((1, 100), 0, False), ((50, 50), 9, True)):
         assert choose(grew_start, *sizes, steps, collided) == (not grew_start, ALTERNATE)
 
 
 def test_balancing_is_the_balancing_rule_else_the_swap_policy():
-    choose = tree_chooser("alternate", balance_tree_sizes=True, max_tree_size_ratio=1.0)
+    choose = tree_rule("alternate", balance_tree_sizes=True, max_tree_size_ratio=1.0)
     for start_size, goal_size in ((10, 10), (10, 19), (10, 20), (20, 10), (1, 100)):
         for grew_start in (True, False):
             rule = balance_choice(start_size, goal_size, True, 1.0)
@@ -62,7 +84,7 @@ def test_balancing_is_the_balancing_rule_else_the_swap_policy():
 
 
 def test_balance_steps_swaps_exactly_at_swap_steps():
-    choose = tree_chooser("balance_steps", swap_steps=4)
+    choose = tree_rule("balance_steps", swap_steps=4)
     for grew_start in (True, False):
         assert [choose(grew_start, 5, 500, steps, True)[0] for steps in range(7)] == [grew_start] * 4 + [
             not grew_start
@@ -71,15 +93,27 @@ def test_balance_steps_swaps_exactly_at_swap_steps():
 
 
 def test_on_collision_swaps_only_after_a_collision():
-    choose = tree_chooser("on_collision")
+    choose = tree_rule("on_collision")
     assert choose(True, 5, 500, 99, False) == (True, COLLISION)
     assert choose(False, 5, 500, 99, False) == (False, COLLISION)
     assert choose(True, 5, 5, 0, True) == (False, COLLISION)
 
 
+def test_tree_choice_resets_its_counts_at_a_swap_and_reports_only_swaps():
+    choice = TreeChoice("balance_steps", SwapState(), swap_steps=2)
+    assert choice.next_tree(1, 1) == (True, STEPS)  # the first iteration: as if due to swap
+    assert (choice.state.steps, choice.state.collided) == (0, False)
+    choice.connect_stepped()
+    assert choice.next_tree(1, 1) == (True, None)  # one step: no swap
+    choice.connect_stepped()
+    choice.connect_ended(trapped=True)
+    assert choice.next_tree(1, 1) == (False, STEPS)
+    assert (choice.state.grew_start, choice.state.steps, choice.state.collided) == (False, 0, False)
+
+
 def test_unknown_swap_policy_names_the_accepted_ones():
     with pytest.raises(ValueError, match="alternate, balance_steps, on_collision"):
-        tree_chooser("sometimes")
+        TreeChoice("sometimes", SwapState())
 
 
 def test_exhaustion_scale_is_the_lab_formula():
@@ -119,78 +153,61 @@ def test_node_quality_is_the_hrrt_formula():
     assert node_quality(2.0, 2.0, 2.0, 0.0) == 1.0  # every node optimal
 
 
-# -- the policies inside a run: recorded with wrappers around the planner's own steps ------
+# -- the policies inside a run: observed through the loop record, on both engines ------------
+
+ENGINES = ["python", "compiled"]
 
 
-def traced_run(monkeypatch, problem: str, **params):
-    """Solve ``problem`` recording each tree choice and each extension step, in order.
-
-    Events: ``("choose", grew_start, steps, collided, grow_start)`` and
-    ``("grow", from_start, target, nearest_given, outcome)``.
-    """
-    events = []
-    real_chooser = planners.tree_chooser
-
-    def recording_chooser(*args, **kwargs):
-        choose = real_chooser(*args, **kwargs)
-
-        def recorded(grew_start, start_size, goal_size, steps, collided):
-            grow_start, cause = choose(grew_start, start_size, goal_size, steps, collided)
-            events.append(("choose", grew_start, steps, collided, grow_start))
-            return grow_start, cause
-
-        return recorded
-
-    monkeypatch.setattr(planners, "tree_chooser", recording_chooser)
+def traced_run(problem: str, engine: str = "python", **params):
+    """Solve ``problem`` on ``engine`` recording each tree choice and each extension step, in order."""
     ss = get_problem(problem).setup()
     planner = BalancedRRTConnect(ss.getSpaceInformation())
-    assert planner.params().setParams({key: str(value) for key, value in params.items()})
-    real_grow = Extender.grow
-
-    def recording_grow(extender, tree, from_start, target, nearest=None):
-        outcome = real_grow(extender, tree, from_start, target, nearest)
-        events.append(("grow", from_start, np.array(target, dtype=float), nearest is not None, outcome[0]))
-        return outcome
-
-    monkeypatch.setattr(Extender, "grow", recording_grow)
+    assert planner.params().setParams({"engine": engine, **{key: str(value) for key, value in params.items()}})
+    planner.loop_record = LoopRecord()
     ss.setPlanner(planner)
     assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
-    return ss, planner, events
+    assert planner.stats.engine == engine
+    return ss, planner, planner.loop_record
 
 
-def replay_swaps(events):
-    """Per iteration: (grew_start, grow_start, connect steps since the last swap, last connect trapped)."""
+def replay_swaps(record):
+    """Per iteration after the first: (grew_start, grow_start, connect steps since the last swap,
+    last connect trapped), counted from the steps the record holds."""
+    steps_by_iteration = {}
+    for step in record.steps:
+        steps_by_iteration.setdefault(step.iteration, []).append(step)
     decisions, steps, collided, current = [], 0, False, None
-    for event in events:
-        if event[0] == "choose":
-            _, _, _, _, grow_start = event
-            decisions.append((current, grow_start, steps, collided))
-            if grow_start != current:
-                steps, collided = 0, False
-            current = grow_start
-        elif event[1] != current:  # a connect step: the other tree grows
-            steps += 1
-            collided = event[4] is Grow.TRAPPED
+    for choice in record.choices:
+        decisions.append((current, choice.grow_start, steps, collided))
+        if choice.grow_start != current:
+            steps, collided = 0, False
+        current = choice.grow_start
+        for step in steps_by_iteration.get(choice.iteration, []):
+            if step.connect:
+                steps += 1
+                collided = step.outcome is Grow.TRAPPED
     return decisions[1:]  # the first iteration has no previous tree
 
 
-def test_balance_steps_swaps_after_exactly_swap_steps_connect_steps(monkeypatch):
-    _ss, planner, events = traced_run(
-        monkeypatch, "bug_trap", swap_policy="balance_steps", swap_steps=3, balance_tree_sizes=0
+@pytest.mark.parametrize("engine", ENGINES)
+def test_balance_steps_swaps_after_exactly_swap_steps_connect_steps(engine):
+    _ss, planner, record = traced_run(
+        "bug_trap", engine, swap_policy="balance_steps", swap_steps=3, balance_tree_sizes=0
     )
-    decisions = replay_swaps(events)
+    decisions = replay_swaps(record)
     assert len(decisions) > 20
     for grew_start, grow_start, steps, _ in decisions:
         assert (grow_start != grew_start) == (steps >= 3)
     # what the planner passed to the rule is what the trace counts
-    passed = [(e[2], e[3]) for e in events if e[0] == "choose"][1:]
+    passed = [(choice.steps, choice.collided) for choice in record.choices][1:]
     assert [steps for steps, _ in passed] == [steps for _, _, steps, _ in decisions]
     assert planner.stats.swaps_steps == planner.stats.tree_swaps == sum(g != s for g, s, _, _ in decisions)
 
 
-def test_on_collision_never_swaps_after_a_collision_free_connect(monkeypatch):
-    _ss, planner, events = traced_run(monkeypatch, "bug_trap", swap_policy="on_collision", balance_tree_sizes=0)
-    decisions = replay_swaps(events)
+@pytest.mark.parametrize("engine", ENGINES)
+def test_on_collision_never_swaps_after_a_collision_free_connect(engine):
+    _ss, planner, record = traced_run("bug_trap", engine, swap_policy="on_collision", balance_tree_sizes=0)
+    decisions = replay_swaps(record)
     swaps = [(grew, grow, collided) for grew, grow, _, collided in decisions]
     assert any(grew != grow for grew, grow, _ in swaps)
     assert any(grew == grow for grew, grow, _ in swaps)  # trapped extensions keep the tree
@@ -198,24 +215,18 @@ def test_on_collision_never_swaps_after_a_collision_free_connect(monkeypatch):
     assert planner.stats.swaps_collision == planner.stats.tree_swaps > 0
 
 
-def extension_targets(events):
+def extension_targets(record):
     """(grown tree is the start tree, target) of each iteration's extension step."""
-    targets, current = [], None
-    for event in events:
-        if event[0] == "choose":
-            current, first = event[4], True
-        elif event[1] == current and first:
-            targets.append((current, event[2]))
-            first = False
-    return targets
+    return [(step.start_tree, step.target) for step in record.steps if not step.connect]
 
 
-def test_strict_goal_ball_never_targets_farther_from_the_goal_than_the_start(monkeypatch):
+@pytest.mark.parametrize("engine", ENGINES)
+def test_strict_goal_ball_never_targets_farther_from_the_goal_than_the_start(engine):
     problem = get_problem("bug_trap")
-    _ss, planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_ball", uniform_rate=0.0)
+    _ss, planner, record = traced_run("bug_trap", engine, sample_policy="goal_ball", uniform_rate=0.0)
     start, goal = np.array(problem.start), np.array(problem.goal)
     radius = np.linalg.norm(goal - start)
-    targets = extension_targets(events)
+    targets = extension_targets(record)
     assert sum(grow_start for grow_start, _ in targets) > 10
     for grow_start, target in targets:
         centre = goal if grow_start else start
@@ -223,51 +234,55 @@ def test_strict_goal_ball_never_targets_farther_from_the_goal_than_the_start(mon
     assert planner.stats.sampler_rejections > 0  # the ball does not cover the square
 
 
-def test_goal_bias_targets_the_other_root_at_the_given_rate(monkeypatch):
+@pytest.mark.parametrize("engine", ENGINES)
+def test_goal_bias_targets_the_other_root_at_the_given_rate(engine):
     problem = get_problem("bug_trap")
-    _ss, _planner, events = traced_run(monkeypatch, "bug_trap", sample_policy="goal_bias", goal_bias=0.5, seed=5)
+    _ss, _planner, record = traced_run("bug_trap", engine, sample_policy="goal_bias", goal_bias=0.5, seed=5)
     roots = {True: np.array(problem.goal), False: np.array(problem.start)}
-    targets = extension_targets(events)
+    targets = extension_targets(record)
     at_root = [np.array_equal(target, roots[grow_start]) for grow_start, target in targets]
     n = len(at_root)
     assert n > 50
     assert abs(sum(at_root) / n - 0.5) < 4 * math.sqrt(0.25 / n)  # within 4 standard deviations
 
 
-def test_exhausted_policy_never_extends_an_exhausted_node(monkeypatch):
-    ss = get_problem("bug_trap").setup()
-    planner = BalancedRRTConnect(ss.getSpaceInformation())
-    planner.setNearestPolicy("exhausted")
-    planner.setExhaustedAfter(2)
-    picks = []
-    make_finder = planners.nearest_finder  # the policy's node finder, built once per solve
-
-    def checking_finder(*args, **kwargs):
-        find = make_finder(*args, **kwargs)
-
-        def checked(tree, target):
-            node, distance = find(tree, target)
-            counts = planner._failures[tree].counts(len(tree))
-            picks.append(counts[node] < 2 or bool(np.all(counts >= 2)))
-            return node, distance
-
-        return checked
-
-    monkeypatch.setattr(planners, "nearest_finder", checking_finder)
-    ss.setPlanner(planner)
-    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
-    assert len(picks) > 10 and all(picks)
+def replay_failures(record):
+    """Per tree (start: True) and node, the failed extensions the record shows before each step,
+    and the nodes each tree had: ``[(step, failures of its tree, nodes of its tree)]``."""
+    failures = {True: {}, False: {}}
+    nodes = {True: {0}, False: {0}}
+    seen = []
+    for step in record.steps:
+        tree_failures = failures[step.start_tree]
+        seen.append((step, dict(tree_failures), set(nodes[step.start_tree])))
+        if step.outcome is Grow.TRAPPED:
+            tree_failures[step.node] = tree_failures.get(step.node, 0) + 1
+        else:
+            nodes[step.start_tree].add(step.added)
+    return seen
 
 
-def test_failed_extensions_are_counted_per_node(monkeypatch):
-    _ss, planner, events = traced_run(monkeypatch, "bug_trap", nearest_policy="exhaustion")
-    trapped = sum(1 for e in events if e[0] == "grow" and e[4] is Grow.TRAPPED)
+@pytest.mark.parametrize("engine", ENGINES)
+def test_exhausted_policy_never_extends_an_exhausted_node(engine):
+    _ss, _planner, record = traced_run("bug_trap", engine, nearest_policy="exhausted", exhausted_after=2)
+    looked_up = [(step, failures, nodes) for step, failures, nodes in replay_failures(record) if not step.node_given]
+    assert len(looked_up) > 10
+    exhausted_picks = [failures.get(step.node, 0) >= 2 for step, failures, _ in looked_up]
+    assert any(count >= 2 for _, failures, _ in looked_up for count in failures.values())  # nodes do get exhausted
+    for (_step, failures, nodes), exhausted in zip(looked_up, exhausted_picks):
+        assert not exhausted or all(failures.get(node, 0) >= 2 for node in nodes)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_failed_extensions_are_counted_per_node(engine):
+    _ss, planner, record = traced_run("bug_trap", engine, nearest_policy="exhaustion")
+    trapped = sum(1 for step in record.steps if step.outcome is Grow.TRAPPED)
     recorded = sum(int(failures.counts(len(tree)).sum()) for tree, failures in planner._failures.items())
     assert trapped > 0 and recorded == trapped
 
 
-def test_euclidean_policy_counts_no_failures(monkeypatch):
-    _ss, planner, _events = traced_run(monkeypatch, "bug_trap")
+def test_euclidean_policy_counts_no_failures():
+    _ss, planner, _record = traced_run("bug_trap")
     assert all(int(f.counts(len(t)).sum()) == 0 for t, f in planner._failures.items())
 
 
@@ -313,7 +328,7 @@ def test_passage_sampler_in_free_space_falls_back_to_uniform_targets():
     start, goal = space.allocState(), space.allocState()
     start[0], start[1], goal[0], goal[1] = 0.05, 0.05, 0.95, 0.95
     ss.setStartAndGoalStates(start, goal)
-    planner = planners.GaussianPassageRRTConnect(ss.getSpaceInformation())
+    planner = GaussianPassageRRTConnect(ss.getSpaceInformation())
     planner.setRange(0.1)  # several iterations, so the sampler is asked
     ss.setPlanner(planner)
     assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
@@ -448,6 +463,7 @@ OTHER_VALUES = {
     "min_quality": "0.2",
     "uniform_rate": "0.4",
     "seed": "9",
+    "engine": "python",
 }
 
 
@@ -492,22 +508,20 @@ def test_a_presets_policy_changes_only_through_its_own_parameters(preset):
 # -- connect steps and the nearest policy ---------------------------------------------------
 
 
+@pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("policy", NEAREST_POLICIES)
-def test_connect_steps_after_the_first_extend_the_node_just_added(monkeypatch, policy):
+def test_connect_steps_after_the_first_extend_the_node_just_added(policy, engine):
     # a short range: connects take many steps
-    _ss, _planner, events = traced_run(monkeypatch, "maze", nearest_policy=policy, balance_tree_sizes=0, range=0.03)
+    _ss, _planner, record = traced_run("maze", engine, nearest_policy=policy, balance_tree_sizes=0, range=0.03)
     firsts, furthers = [], []  # connect steps: was the node handed over (no search)?
-    current, in_connect = None, False
-    for event in events:
-        if event[0] == "choose":
-            current, in_connect = event[4], False
-        elif event[1] != current:  # a connect step: the other tree grows
-            (furthers if in_connect else firsts).append(event[3])
-            in_connect = True
-        else:
-            in_connect = False
-    assert len(furthers) > 10 and all(furthers)
-    assert firsts and not any(firsts)  # the first step asks the policy
+    previous = None
+    for step in record.steps:
+        if step.connect:
+            further = previous is not None and previous.connect and previous.iteration == step.iteration
+            (furthers if further else firsts).append((step.node_given, step.node, previous.added if further else None))
+        previous = step
+    assert len(furthers) > 10 and all(given and node == added for given, node, added in furthers)
+    assert firsts and not any(given for given, _, _ in firsts)  # the first step asks the policy
 
 
 def test_exhaustion_can_prefer_an_older_failed_node_to_the_node_just_added():
@@ -518,24 +532,30 @@ def test_exhaustion_can_prefer_an_older_failed_node_to_the_node_just_added():
     failures = {tree: NodeFailures()}
     for _ in range(5):
         failures[tree].record(old)
-    find = nearest_finder("exhaustion", failures, exhaustion_target=5)
+    policy = nearest_choice("exhaustion", failures, exhaustion_target=5)
     target = np.array([1.0, 0.0])
-    assert find(tree, target)[0] == old
+    assert policy.node(tree, target)[0] == old
     fresh = tree.add(np.array([0.05, 0.0]), old)  # the connect's step from ``old`` towards the target
     assert tree.nearest(target)[0] == fresh
-    assert find(tree, target)[0] == old  # 1.0 x 0.9 < 0.95 x 1.0: ``old`` again, the same step again
+    assert policy.node(tree, target)[0] == old  # 1.0 x 0.9 < 0.95 x 1.0: ``old`` again, the same step again
 
 
-def test_neighbour_quality_asks_the_finder_it_is_given():
+def test_neighbour_quality_asks_the_nearest_policy_it_is_given():
     """The nearest policy reaches neighbour_quality through its context, nothing else."""
     tree, other = ArrayTree(2), ArrayTree(2)
     tree.add(np.array([0.1, 0.1]))
     other.add(np.array([0.9, 0.9]))
     asked = []
 
-    def finder(searched, point):
-        asked.append(searched is tree)
-        return 0, float(np.linalg.norm(point - searched.state(0)))
+    class Finder:
+        @staticmethod
+        def node(searched, point):
+            asked.append(searched is tree)
+            return 0, float(np.linalg.norm(point - searched.state(0)))
+
+        @staticmethod
+        def failed(searched, node):
+            raise AssertionError("neighbour_quality records no failures")
 
     class Uniform:
         def __init__(self):
@@ -548,10 +568,10 @@ def test_neighbour_quality_asks_the_finder_it_is_given():
         def distance(a, b):
             return float(np.linalg.norm(a - b))
 
-    context = SampleContext(Uniform(), tree, other, np.random.default_rng(2).random, SamplerCounts(), finder)
-    sample = target_sampler("neighbour_quality", context)
+    context = SampleContext(Uniform(), tree, other, np.random.default_rng(2).random, SamplerCounts(), Finder())
+    policy = target_choice("neighbour_quality", context)
     for _ in range(20):
-        target, nearest = sample(True)
+        target, nearest = policy.target(True)
         assert target is not None and nearest == 0
     assert len(asked) == 20 and all(asked)
 
@@ -580,9 +600,9 @@ def test_goal_ball_takes_a_uniform_target_at_the_uniform_rate(rate):
     goal.add(np.array([1.0, 0.0]))
     counts = SamplerCounts()
     context = SampleContext(_FarSampler(), start, goal, np.random.default_rng(4).random, counts, uniform_rate=rate)
-    sample = target_sampler("goal_ball", context)
+    policy = target_choice("goal_ball", context)
     n = 2000
-    uniform = sum(sample(True)[0] is not None for _ in range(n))  # the ball rejects every far point
+    uniform = sum(policy.target(True)[0] is not None for _ in range(n))  # the ball rejects every far point
     assert abs(uniform / n - rate) <= 4 * math.sqrt(rate * (1 - rate) / n)
     assert counts.rejections == (n - uniform) * SAMPLE_ATTEMPTS
 

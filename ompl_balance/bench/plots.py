@@ -228,6 +228,7 @@ def grow_trees(problem: str, balance: bool, iterations: int, seed: int = 1) -> t
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     planner.setBalanceTreeSizes(balance)
     planner.setSeed(seed)
+    planner.setEngine("python")  # polls its condition every iteration (the compiled engine every millisecond)
     ss.setPlanner(planner)
     ss.setup()
     checks = 0

@@ -42,6 +42,9 @@ DISTANCE_TOLERANCE = 1e-5
 #: A failing segment is halved on sphere bounds alone, without GJK, while its travel bound
 #: is at most this many times the room its end bounds leave (a level or two more).
 SPHERE_REACH = 8.0
+#: A segment whose travel bound is below this (m) and is still not certified is not cut
+#: again: the edge is rejected (grazing contact).
+MIN_TRAVEL = 1e-7
 #: Deepest bisection level (segments of 2**-MAX_LEVEL of the edge); a segment that deep
 #: and still uncertified fails.
 MAX_LEVEL = 48
@@ -231,36 +234,104 @@ def _grow(array: np.ndarray, size: int) -> np.ndarray:  # pragma: no cover (comp
     return bigger
 
 
+class EdgeModel(NamedTuple):
+    """What :func:`advance` certifies against, fixed for a certifier: the robot's ``chain``, the
+    checker's ``volumes``, the certifier's :class:`Model`, ``clearance`` (m: pairs must stay
+    farther apart), ``handover`` (m of travel below which non-convex pairs go to FCL) and
+    ``floor`` (m: a segment failing with less travel fails the edge)."""
+
+    chain: Chain
+    volumes: Volumes
+    model: Model
+    clearance: float
+    handover: float
+    floor: float
+
+
+class EdgeScratch(NamedTuple):
+    """What :func:`advance` writes besides the remembered bounds: ``warm`` (pairs, 3) each
+    pair's last GJK direction, ``speed`` (pairs,) each pair's travel bound per unit ``t`` on the
+    last edge, and the hard segments, pair ``hard_pair[i]`` (capacity,) over ``hard_span[i]`` =
+    (t0, t1, d0, d1) (capacity, 4), grown when needed."""
+
+    warm: np.ndarray
+    speed: np.ndarray
+    hard_pair: np.ndarray
+    hard_span: np.ndarray
+
+
+class EndMemory(NamedTuple):
+    """Bounds at the last edge end configurations, one row each, reused in turn (oldest first).
+
+    Planners extend from the same tree states again and again; what was computed there is
+    kept (as lower bounds they hold for any edge). ``keys`` (rows, dof) are the configurations
+    of rows in ``used``; ``generation`` (rows,) counts each row's reuses (so Python-side
+    memories of a row can tell a new configuration); ``next`` (1,) the row reused next;
+    ``bounds`` the remembered bounds.
+    """
+
+    keys: np.ndarray
+    used: np.ndarray
+    generation: np.ndarray
+    next: np.ndarray
+    bounds: Remembered
+
+
+def end_memory(rows: int, dof: int, pairs: int) -> EndMemory:
+    """An empty :class:`EndMemory` of ``rows`` configurations of ``dof`` joints and ``pairs`` pairs."""
+    return EndMemory(
+        np.zeros((rows, dof)),
+        np.zeros(rows, dtype=np.bool_),
+        np.zeros(rows, dtype=np.int64),
+        np.zeros(1, dtype=np.int64),
+        Remembered(np.full((rows, pairs), np.nan), np.full((rows, pairs), np.inf), np.zeros((rows, pairs), dtype=bool)),
+    )
+
+
+@njit(cache=True)
+def memory_row(memory: EndMemory, q: np.ndarray) -> int:  # pragma: no cover (compiled)
+    """The row of configuration ``q`` (dof,) in ``memory``; the oldest row, cleared, if ``q`` is not remembered."""
+    keys = memory.keys
+    for row in range(keys.shape[0]):
+        if memory.used[row]:
+            same = True
+            for j in range(q.shape[0]):
+                if keys[row, j] != q[j]:
+                    same = False
+                    break
+            if same:
+                return row
+    row = memory.next[0]
+    memory.next[0] = (row + 1) % keys.shape[0]
+    for j in range(q.shape[0]):
+        keys[row, j] = q[j]
+    memory.used[row] = True
+    memory.generation[row] += 1
+    bounds = memory.bounds
+    for pair in range(bounds.lower.shape[1]):
+        bounds.lower[row, pair], bounds.upper[row, pair], bounds.final[row, pair] = np.nan, np.inf, False
+    return row
+
+
 @njit(cache=True)
 def advance(
     a: np.ndarray,
     b: np.ndarray,
-    chain: Chain,
-    volumes: Volumes,
-    model: Model,
-    clearance: float,
-    handover: float,
-    floor: float,
-    settle: float,
-    stop: bool,
+    edge: EdgeModel,
     remembered: Remembered,
     start: int,
     end: int,
-    warm: np.ndarray,
-    speed: np.ndarray,
-    hard_pair: np.ndarray,
-    hard_span: np.ndarray,
+    settle: float,
+    stop: bool,
+    scratch: EdgeScratch,
 ) -> tuple[bool, float, int, int, int, np.ndarray, np.ndarray]:  # pragma: no cover (compiled)
     """Certify the edge ``a -> b`` (dof,) for every pair but the hard segments.
 
-    ``clearance`` (m): pairs must stay farther apart. A segment failing with a travel
-    bound below ``floor`` (m) fails the edge; ``stop``: return at the first failure;
-    otherwise a segment reaching a failure found earlier is refined to ``settle`` (m) of
-    travel only (where the last certified fraction is wanted, not a certificate).
-    ``remembered`` rows ``start`` and ``end`` hold the bounds known at ``a`` and ``b`` and
-    receive what is computed there. ``warm`` (pairs, 3): each pair's last GJK direction. Writes each pair's
-    travel bound per unit ``t`` into ``speed``. Hard segments: pair ``hard_pair[i]``,
-    ``hard_span[i]`` = (t0, t1, d0, d1).
+    ``edge``: what to certify against (:class:`EdgeModel`). ``remembered`` rows ``start`` and
+    ``end`` hold the bounds known at ``a`` and ``b`` and receive what is computed there.
+    ``stop``: return at the first failure; otherwise a segment reaching a failure found
+    earlier is refined to ``settle`` (m) of travel only (where the last certified fraction is
+    wanted, not a certificate). ``scratch``: see :class:`EdgeScratch`.
 
     Returns ``failed`` (an end outside the joint bounds or not finite, a contact, or a
     segment that cannot be certified), ``bad`` (the edge is certified for all pairs on
@@ -268,6 +339,9 @@ def advance(
     configurations evaluated and of GJK distance bounds computed, and the (possibly grown)
     hard arrays.
     """
+    chain, volumes, model = edge.chain, edge.volumes, edge.model
+    clearance, handover, floor = edge.clearance, edge.handover, edge.floor
+    warm, speed, hard_pair, hard_span = scratch.warm, scratch.speed, scratch.hard_pair, scratch.hard_span
     dof = len(a)
     for j in range(dof):
         for value in (a[j], b[j]):  # (NaN fails both comparisons)

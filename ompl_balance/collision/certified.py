@@ -69,55 +69,30 @@ import math
 from collections import deque
 from dataclasses import dataclass
 
-import fcl
 import numpy as np
 
-from .advancement import DISTANCE_TOLERANCE, Model, Remembered, advance, hull_bounds, sphere_bounds
+from ..core.checks import exit_handle
+from .advancement import (
+    DISTANCE_TOLERANCE,
+    MIN_TRAVEL,
+    EdgeModel,
+    EdgeScratch,
+    Model,
+    advance,
+    end_memory,
+    hull_bounds,
+    memory_row,
+    sphere_bounds,
+)
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
-from .screening import entry_point, stand_ins
+from .kernels import CertifiedMotions, certified_motion_free, robot_states
+from .screening import entry_point
 from .travel import travel_weights
 
-#: A segment whose travel bound is below this (m) and is still not certified is not cut
-#: again: the edge is rejected (grazing contact).
-MIN_TRAVEL = 1e-7
 #: Travel (m) to which ``check(..., last_valid=True)`` refines the edge around its first
 #: failure before it reports the last certified fraction.
 LAST_VALID_TRAVEL = 1e-3
-
-_DISTANCE_REQUEST = fcl.DistanceRequest()
-
-
-class _EndMemory:
-    """Bounds at the last ``size`` edge end configurations: a row of arrays each, reused in turn.
-
-    Planners extend from the same tree states again and again; what the compiled phase
-    and FCL computed there is kept (as lower bounds they hold for any edge).
-    """
-
-    def __init__(self, size: int, pairs: int):
-        self.bounds = Remembered(
-            np.full((size, pairs), np.nan), np.full((size, pairs), np.inf), np.zeros((size, pairs), dtype=bool)
-        )
-        self.exact: list[dict[int, float]] = [{} for _ in range(size)]  # pair -> FCL distance
-        self._rows: dict[bytes, int] = {}
-        self._keys: list[bytes | None] = [None] * size
-        self._next = 0
-
-    def row(self, q: np.ndarray) -> int:
-        """The row of configuration ``q``, a cleared one (the oldest) if it is not remembered."""
-        key = q.tobytes()
-        row = self._rows.get(key)
-        if row is None:
-            row = self._next
-            self._next = (row + 1) % len(self._keys)
-            old = self._keys[row]
-            if old is not None:
-                del self._rows[old]
-            self._keys[row], self._rows[key] = key, row
-            self.bounds.lower[row], self.bounds.upper[row], self.bounds.final[row] = np.nan, np.inf, False
-            self.exact[row].clear()
-        return row
 
 
 class MotionCertifier:
@@ -154,20 +129,31 @@ class MotionCertifier:
         self._robot = robot = checker.robot
         self._geometries = len(robot.geometries)
         self._obstacles = len(checker.environment.obstacles)
-        self.pair_count = self._obstacles * self._geometries + len(robot.self_collision_pairs)
+        self.pair_count = checker.pair_count
         self._model = self._build_model()
-        self._speed = np.empty(self.pair_count)
-        self._warm = np.zeros((self.pair_count, 3))
         self._identity = np.eye(4).reshape(1, 4, 4)
-        self._hard_pair = np.empty(16, dtype=np.int64)
-        self._hard_span = np.empty((16, 4))
-        self._memory = _EndMemory(max(2, remembered), self.pair_count)
-        self._model_arguments = (robot.chain, checker._volumes, self._model, self.clearance, self.handover, MIN_TRAVEL)
-        self._scratch = (self._warm, self._speed, self._hard_pair, self._hard_span)
-        # the compiled phase is called without numba's type dispatch (several microseconds
+        self._edge = EdgeModel(robot.chain, checker.volumes, self._model, self.clearance, self.handover, MIN_TRAVEL)
+        capacity = 4 * self.pair_count + 16  # hard segments before the arrays grow
+        self._scratch = EdgeScratch(
+            np.zeros((self.pair_count, 3)),
+            np.empty(self.pair_count),
+            np.empty(capacity, dtype=np.int64),
+            np.empty((capacity, 4)),
+        )
+        self._memory = end_memory(max(2, remembered), robot.dof, self.pair_count)
+        # FCL distances at remembered rows (pair -> distance), valid for the row's generation
+        self._exact: list[tuple[int, dict[int, float]]] = [(-1, {}) for _ in range(len(self._memory.used))]
+        # the compiled kernels are called without numba's type dispatch (several microseconds
         # of an edge's few tens): the argument types are fixed here
         lower = np.ascontiguousarray(robot.lower, dtype=float)
-        self._advance = entry_point(advance, self._arguments(lower, lower, 0, 0, MIN_TRAVEL, stop=True))
+        self._view = CertifiedMotions(
+            robot_states(checker), self._edge, self._memory, self._scratch, exit_handle(self), checker.counter.array
+        )
+        self._row = entry_point(memory_row, (self._memory, lower))
+        self._advance = entry_point(
+            advance, (lower, lower, self._edge, self._memory.bounds, 0, 1, MIN_TRAVEL, True, self._scratch)
+        )
+        self._edge_free = entry_point(certified_motion_free, (self._view, lower, lower))
 
     def _build_model(self) -> Model:
         robot, obstacles = self._robot, self.checker.environment.obstacles
@@ -194,7 +180,7 @@ class MotionCertifier:
             poses = robot.body_poses(np.zeros(robot.dof))[0]
             for o in range(self._obstacles):
                 for g in np.flatnonzero(still):
-                    fixed[o * self._geometries + g] = max(self._fcl_distance(o * self._geometries + g, poses), -1.0)
+                    fixed[o * self._geometries + g] = max(self._distance(o * self._geometries + g, poses), -1.0)
         return Model(
             parts=parts,
             obstacle_centre=np.array([c for c, _ in around], dtype=float).reshape(-1, 3),
@@ -212,41 +198,45 @@ class MotionCertifier:
     def check(self, a: np.ndarray, b: np.ndarray, last_valid: bool = False) -> tuple[bool, float]:
         """Whether the edge ``a -> b`` (dof,) is certified, and the fraction of it certified.
 
-        Counts one motion, the configurations evaluated and the FCL distance queries in the
+        Counts one motion, the configurations evaluated and the distance queries in the
         checker's counter. Non-finite or out-of-bounds ends: not certified, fraction 0.
         Without ``last_valid`` the work stops at the first failure and a rejected edge
-        reports fraction 0. With ``last_valid`` the edge is refined around its first
-        failure to :data:`LAST_VALID_TRAVEL` of travel, and ``a + s (b - a)`` is
-        certified for every ``s`` up to the fraction returned.
+        reports fraction 0 (the compiled engine's kernel, :func:`~ompl_balance.collision.kernels.certified_motion_free`).
+        With ``last_valid`` the edge is refined around its first failure to
+        :data:`LAST_VALID_TRAVEL` of travel, and ``a + s (b - a)`` is certified for every ``s``
+        up to the fraction returned.
         """
-        counter = self.checker.counter
-        counter.motions_checked += 1
         a = np.ascontiguousarray(a, dtype=float)
         b = np.ascontiguousarray(b, dtype=float)
         if a.shape != (self._robot.dof,) or b.shape != a.shape:
+            self.checker.counter.motions_checked += 1
             return False, 0.0
-        start, end = self._memory.row(a), self._memory.row(b)
+        if self.checker.prefilter and not last_valid:
+            free = bool(self._edge_free(self._view, a, b))
+            return free, 1.0 if free else 0.0
+        self.checker.counter.motions_checked += 1
+        start, end = self._row(self._memory, a), self._row(self._memory, b)
         settle = max(MIN_TRAVEL, LAST_VALID_TRAVEL) if last_valid else MIN_TRAVEL
         if self.checker.prefilter:
             failed, bad, hard, evaluated, bounded, hard_pair, hard_span = self._advance(
-                *self._arguments(a, b, start, end, settle, stop=not last_valid)
+                a, b, self._edge, self._memory.bounds, start, end, settle, False, self._scratch
             )
-            if hard_pair is not self._hard_pair:  # grown
-                self._hard_pair, self._hard_span = hard_pair, hard_span
-                self._scratch = (self._warm, self._speed, self._hard_pair, self._hard_span)
-            counter.states_checked += evaluated
-            counter.distance_queries += bounded
-            if failed and (not last_valid or bad == 0.0):
+            self.checker.counter.states_checked += evaluated
+            self.checker.counter.distance_queries += bounded
+            if failed and bad == 0.0:
                 return False, 0.0
             if hard == 0:
                 return (False, bad) if failed else (True, 1.0)
-            pairs, spans = self._hard_pair[:hard], self._hard_span[:hard]
+            pairs, spans = hard_pair[:hard], hard_span[:hard]
         else:  # the reference: every pair over the whole edge with FCL only
-            if not (self._inside(a) and self._inside(b)):
+            inside = self._robot.within_limits(np.stack([a, b]))
+            if not inside.all():
                 return False, 0.0
             delta = np.abs(b - a)
             per_geometry = self._model.environment_weight @ delta
-            self._speed[:] = np.concatenate([np.tile(per_geometry, self._obstacles), self._model.self_weight @ delta])
+            self._scratch.speed[:] = np.concatenate(
+                [np.tile(per_geometry, self._obstacles), self._model.self_weight @ delta]
+            )
             failed, bad = False, 1.0
             pairs = np.arange(self.pair_count)
             spans = np.tile([0.0, 1.0, -np.inf, -np.inf], (self.pair_count, 1))
@@ -255,9 +245,18 @@ class MotionCertifier:
             return False, bad if last_valid else 0.0
         return True, 1.0
 
-    def _arguments(self, a: np.ndarray, b: np.ndarray, start: int, end: int, settle: float, stop: bool) -> tuple:
-        """The arguments of :func:`~ompl_balance.collision.advancement.advance` for the edge ``a -> b``."""
-        return (a, b, *self._model_arguments, settle, stop, self._memory.bounds, start, end, *self._scratch)
+    def compiled_view(self) -> CertifiedMotions:
+        """The certifier as compiled code sees it (:class:`~ompl_balance.collision.kernels.CertifiedMotions`)."""
+        return self._view
+
+    def hard_segments_free(
+        self, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int
+    ) -> bool:
+        """Whether FCL certifies the hard segments ``(pair, (t0, t1, d0, d1))`` that the compiled
+        phase of the edge ``a -> b`` left (rows ``start``, ``end`` of the end memory); the compiled
+        kernel's exit."""
+        failed, _ = self._exact_phase(a, b, pairs, spans, start, end, MIN_TRAVEL, False, False, 1.0)
+        return not failed
 
     def closest(self, q: np.ndarray) -> float:
         """The smallest FCL distance (m) between the collision pairs at configuration ``q`` (dof,).
@@ -267,7 +266,7 @@ class MotionCertifier:
         q = np.ascontiguousarray(q, dtype=float)
         poses = self._robot.body_poses(q)[0]
         warm = np.zeros((self.pair_count, 3))
-        volumes = self.checker._volumes
+        volumes = self.checker.volumes
         pairs = np.arange(self.pair_count)
         lower = np.empty(self.pair_count)
         sphere_bounds(poses, volumes, self._model, pairs, lower)
@@ -277,40 +276,25 @@ class MotionCertifier:
         for pair in np.argsort(lower):
             if lower[pair] >= best:
                 break
-            best = min(best, self._fcl_distance(pair, poses) + DISTANCE_TOLERANCE)
+            best = min(best, self._distance(pair, poses) + DISTANCE_TOLERANCE)
             if best <= 0.0:
                 return 0.0
         return float(best)
 
     # ------------------------------------------------------------------ internals
 
-    def _inside(self, q: np.ndarray) -> bool:
-        robot = self._robot
-        return bool(q.shape == (robot.dof,) and np.all(q >= robot.lower) and np.all(q <= robot.upper))
-
-    def _objects(self, pair: int) -> tuple[fcl.CollisionObject, fcl.CollisionObject, tuple[int, ...]]:
-        """The FCL objects of ``pair`` and the link geometries among them."""
-        checker = self.checker
-        if pair < self._obstacles * self._geometries:
-            o, g = divmod(pair, self._geometries)
-            return checker._links[g], checker._obstacles[o], (g,)
-        a, b = self._robot.self_collision_pairs[pair - self._obstacles * self._geometries]
-        return checker._links[a], checker._links[b], (a, b)
-
-    def _touching(self, pair: int, poses: np.ndarray) -> bool:
-        """FCL's collision test of ``pair`` at body ``poses``."""
-        first, second, links = self._objects(pair)
-        for g in links:
-            self.checker._place(poses, g)
-        return bool(fcl.collide(first, second, self.checker._request, fcl.CollisionResult()))
-
-    def _fcl_distance(self, pair: int, poses: np.ndarray) -> float:
+    def _distance(self, pair: int, poses: np.ndarray) -> float:
         """FCL's distance of ``pair`` at body ``poses`` less the tolerance; ``-inf`` in contact."""
-        if self._touching(pair, poses):
+        if self.checker.pair_touching(pair, poses):
             return -np.inf
-        first, second, _links = self._objects(pair)
-        self.checker.counter.distance_queries += 1
-        return fcl.distance(first, second, _DISTANCE_REQUEST, fcl.DistanceResult()) - DISTANCE_TOLERANCE
+        return self.checker.pair_distance(pair, poses) - DISTANCE_TOLERANCE
+
+    def _known(self, row: int) -> dict[int, float]:
+        """The FCL distances remembered at end-memory ``row`` (forgotten when the row is reused)."""
+        generation = int(self._memory.generation[row])
+        if self._exact[row][0] != generation:
+            self._exact[row] = (generation, {})
+        return self._exact[row][1]
 
     def _exact_phase(
         self,
@@ -332,7 +316,7 @@ class MotionCertifier:
         ``last_valid`` it returns at the first failure. Segments reaching a failure are
         refined to ``settle`` metres of travel only.
         """
-        clearance, speed, delta = self.clearance, self._speed, b - a
+        clearance, speed, delta = self.clearance, self._scratch.speed, b - a
         poses_at: dict[float, np.ndarray] = {}
         exact: dict[tuple[int, float], float] = {}
 
@@ -343,18 +327,18 @@ class MotionCertifier:
             return poses_at[t]
 
         def distance(pair: int, t: float) -> float:
-            known = self._memory.exact[start] if t == 0.0 else self._memory.exact[end] if t == 1.0 else None
+            known = self._known(start) if t == 0.0 else self._known(end) if t == 1.0 else None
             if known is not None and pair in known:
                 return known[pair]
             if (pair, t) not in exact:
-                exact[pair, t] = self._fcl_distance(pair, poses(t))
+                exact[pair, t] = self._distance(pair, poses(t))
                 if known is not None:
                     known[pair] = exact[pair, t]
             return exact[pair, t]
 
         if not last_valid:  # contacts first: an FCL collision test costs a few microseconds
             for pair, (t0, t1, _, _) in zip(pairs.tolist(), spans.tolist()):
-                if self._touching(pair, poses(0.5 * (t0 + t1))):
+                if self.checker.pair_touching(pair, poses(0.5 * (t0 + t1))):
                     return True, 0.0
         order = np.argsort(spans[:, 0] - spans[:, 1], kind="stable")  # widest first: coarse to fine
         queue = deque((int(pairs[i]), *spans[i].tolist()) for i in order)
@@ -434,7 +418,7 @@ def certify_states(checker: CollisionChecker, states: np.ndarray, clearance: flo
         if not ok:
             first_bad = i
             break
-    inside = [certifier._inside(q) for q in states]
+    inside = checker.robot.within_limits(states).tolist()
     smallest = min(certifier.closest(q) if ok else -np.inf for q, ok in zip(states, inside))
     certified = first_bad is None and all(inside) and smallest > clearance + DISTANCE_TOLERANCE
     return PathCertificate(
@@ -444,44 +428,4 @@ def certify_states(checker: CollisionChecker, states: np.ndarray, clearance: flo
         certified_fraction=fraction if first_bad is not None else 1.0,
         smallest_clearance=smallest,
         clearance=clearance,
-    )
-
-
-def warm_up() -> None:
-    """Compile the advancement kernel, or load it from numba's cache, for the argument types
-    every certifier passes (a robot without geometry stands in), as
-    :func:`~ompl_balance.collision.screening.warm_up` does for the checker's kernels."""
-    chain, volumes = stand_ins()
-    model = Model(
-        parts=pack_parts([]),
-        obstacle_centre=np.zeros((0, 3)),
-        obstacle_radius=np.zeros(0),
-        environment_weight=np.zeros((0, 1)),
-        self_weight=np.zeros((0, 1)),
-        fixed=np.zeros(0),
-        solid=np.zeros(0, dtype=bool),
-        joint_lower=np.zeros(1),
-        joint_upper=np.zeros(1),
-    )
-    q = np.zeros(1)
-    hard_pair, hard_span = np.zeros(1, dtype=np.int64), np.zeros((1, 4))
-    memory = _EndMemory(2, 0).bounds
-    advance(
-        q,
-        q,
-        chain,
-        volumes,
-        model,
-        0.0,
-        0.01,
-        MIN_TRAVEL,
-        MIN_TRAVEL,
-        True,
-        memory,
-        0,
-        1,
-        np.zeros((0, 3)),
-        q[:0],
-        hard_pair,
-        hard_span,
     )

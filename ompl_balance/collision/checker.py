@@ -23,14 +23,30 @@ The checker counts what it checks in its :class:`WorkCounter`, which the OMPL ad
 
 from __future__ import annotations
 
+from typing import Any
+
 import fcl
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..core.checks import Count, new_counts
 from .environment import Environment
 from .geometry import fcl_transform
 from .kinematics import RobotModel
-from .screening import build_volumes, entry_point, screen
+from .screening import Volumes, build_volumes, entry_point, screen
+
+
+class _Count:
+    """An entry of a :class:`WorkCounter`'s array, read and written as an ``int``."""
+
+    def __init__(self, index: Count) -> None:
+        self.index = index
+
+    def __get__(self, counter: Any, owner: type | None = None) -> Any:
+        return self if counter is None else int(counter.array[self.index])
+
+    def __set__(self, counter: Any, value: int) -> None:
+        counter.array[self.index] = value
 
 
 class WorkCounter:
@@ -39,13 +55,17 @@ class WorkCounter:
     ``states_checked``: configurations evaluated (a state check, a state of a discrete
     edge, a configuration a certified edge was bounded at); ``motions_checked``: edges;
     ``distance_queries``: distance bounds computed by GJK on convex hulls and FCL exact
-    distances (certified motions only).
+    distances (certified motions only). The counts live in :attr:`array` (indexed by
+    :class:`~ompl_balance.core.checks.Count`), which compiled kernels increment in place.
     """
 
     def __init__(self) -> None:
-        self.states_checked = 0
-        self.motions_checked = 0
-        self.distance_queries = 0
+        self.array = new_counts()
+
+    states_checked = _Count(Count.STATES)
+    motions_checked = _Count(Count.MOTIONS)
+    distance_queries = _Count(Count.DISTANCE_QUERIES)
+    exits = _Count(Count.EXITS)  # calls from compiled code to Python (FCL)
 
     def counters(self) -> dict[str, int]:
         return {
@@ -55,9 +75,7 @@ class WorkCounter:
         }
 
     def reset(self) -> None:
-        self.states_checked = 0
-        self.motions_checked = 0
-        self.distance_queries = 0
+        self.array[:] = 0
 
 
 class CollisionChecker:
@@ -89,6 +107,7 @@ class CollisionChecker:
         self.counter = WorkCounter()
         geometries, obstacles = robot.geometries, self.environment.obstacles
         self._request = fcl.CollisionRequest()
+        self._distance_request = fcl.DistanceRequest()
 
         self._geometry_origin = np.array([g.origin for g in geometries]).reshape(-1, 4, 4)
         self._origin_is_identity = [bool(np.array_equal(g.origin, np.eye(4))) for g in geometries]
@@ -111,29 +130,39 @@ class CollisionChecker:
     # ------------------------------------------------------------------ public API
 
     def check(self, q: ArrayLike) -> np.ndarray:
-        """Validity (collision-free) of each configuration: ``q`` (n, dof) or (dof,) -> bool (n,)."""
-        q = self.robot.as_array(q)
+        """Validity of each configuration: ``q`` (n, dof) or (dof,) -> bool (n,).
+
+        A configuration with a non-finite value or outside the joint limits is not valid.
+        """
+        q = self.robot.as_array(q, finite=False)
         self.counter.states_checked += len(q)
+        inside = self.robot.within_limits(q)
+        valid = np.zeros(len(q), dtype=bool)
+        rows = np.flatnonzero(inside)
+        if len(rows) == 0:
+            return valid
         if not self.prefilter:
-            return np.array([self._free_reference(p) for p in self.robot.body_poses(q)], dtype=bool)
-        outputs = self._screen_outputs(len(q))
-        maybe = self._screen(q, outputs)
+            valid[rows] = [self._free_reference(p) for p in self.robot.body_poses(q[rows])]
+            return valid
+        outputs = self._screen_outputs(len(rows))
+        maybe = self._screen(q[rows], outputs)
         poses, obstacle_hits, self_hits = outputs
-        valid = ~maybe
-        for i in np.flatnonzero(maybe):
-            valid[i] = self._free_exact(poses[i], obstacle_hits[i], self_hits[i])
+        for k in range(len(rows)):
+            valid[rows[k]] = not maybe[k] or self.decide(poses[k], obstacle_hits[k], self_hits[k])
         return valid
 
     def is_valid(self, q: ArrayLike) -> bool:
-        """Validity of one configuration ``q`` (dof,)."""
-        q = self.robot.as_array(q)
+        """Validity of one configuration ``q`` (dof,); ``False`` for non-finite values or outside the joint limits."""
+        q = self.robot.as_array(q, finite=False)
         if len(q) != 1:
             raise ValueError(f"is_valid takes one configuration of {self.robot.dof} joint values, got shape {q.shape}")
         self.counter.states_checked += 1
+        if not self.robot.within_limits(q)[0]:
+            return False
         if not self.prefilter:
             return self._free_reference(self.robot.body_poses(q)[0])
         poses, obstacle_hits, self_hits = self._one
-        return not self._screen(q, self._one)[0] or self._free_exact(poses[0], obstacle_hits[0], self_hits[0])
+        return not self._screen(q, self._one)[0] or self.decide(poses[0], obstacle_hits[0], self_hits[0])
 
     def first_collision(self, q: ArrayLike, order: ArrayLike | None = None, first_chunk: int = 1) -> int:
         """Index of the first configuration in collision, visiting ``q`` (n, dof) in ``order``, or -1.
@@ -141,26 +170,31 @@ class CollisionChecker:
         The first ``first_chunk`` rows of ``order`` (default: row order) go through
         forward kinematics and the screening together, then the rest together; the exact
         tests run row by row in ``order`` and stop at the first collision. Rows of a chunk
-        that was processed count as states checked.
+        that was processed count as states checked. A configuration outside the joint
+        limits counts as in collision.
         """
         q = self.robot.as_array(q)
         order = np.arange(len(q)) if order is None else np.asarray(order, dtype=int)
+        inside = self.robot.within_limits(q)
         for chunk in (order[:first_chunk], order[first_chunk:]):
             if len(chunk) == 0:
                 continue
             self.counter.states_checked += len(chunk)
             if not self.prefilter:
                 poses = self.robot.body_poses(q[chunk])
-                hit = next((k for k in range(len(chunk)) if not self._free_reference(poses[k])), -1)
+                hit = next(
+                    (k for k in range(len(chunk)) if not inside[chunk[k]] or not self._free_reference(poses[k])), -1
+                )
             else:
                 outputs = self._screen_outputs(len(chunk))
                 maybe = self._screen(q[chunk], outputs)
                 poses, obstacle_hits, self_hits = outputs
                 hit = next(
                     (
-                        int(k)
-                        for k in np.flatnonzero(maybe)
-                        if not self._free_exact(poses[k], obstacle_hits[k], self_hits[k])
+                        k
+                        for k in range(len(chunk))
+                        if not inside[chunk[k]]
+                        or (maybe[k] and not self.decide(poses[k], obstacle_hits[k], self_hits[k]))
                     ),
                     -1,
                 )
@@ -174,7 +208,75 @@ class CollisionChecker:
     def reset_counters(self) -> None:
         self.counter.reset()
 
+    @property
+    def volumes(self) -> Volumes:
+        """The bounding volumes of the screening (:class:`~ompl_balance.collision.screening.Volumes`)."""
+        return self._volumes
+
+    @property
+    def pair_count(self) -> int:
+        """Collision pairs: pair ``o * geometries + g`` is link geometry ``g`` against obstacle
+        ``o``; pair ``obstacles * geometries + s`` is self-collision pair ``s``."""
+        return len(self._obstacles) * len(self._links) + len(self._pairs)
+
+    def decide(self, body_poses: np.ndarray, obstacle_hits: np.ndarray, self_hits: np.ndarray) -> bool:
+        """FCL on the pairs the screening did not clear in one configuration; True if none collides.
+
+        ``body_poses`` (bodies, 4, 4), ``obstacle_hits`` (obstacles, geometries) and
+        ``self_hits`` (pairs) as the screening (:func:`~ompl_balance.collision.screening.screen`)
+        filled them for that configuration.
+        """
+        placed: set[int] = set()
+
+        def place(geometry: int) -> None:
+            if geometry not in placed:
+                self._place(body_poses, geometry)
+                placed.add(geometry)
+
+        for o, g in zip(*np.nonzero(obstacle_hits)):
+            place(g)
+            if self._collide(self._links[g], self._obstacles[o]):
+                return False
+        for p in np.flatnonzero(self_hits):
+            a, b = self._pairs[p]
+            place(a)
+            place(b)
+            if self._collide(self._links[a], self._links[b]):
+                return False
+        return True
+
+    def pair_touching(self, pair: int, body_poses: np.ndarray) -> bool:
+        """FCL's collision test of ``pair`` (see :attr:`pair_count`) at body poses (bodies, 4, 4)."""
+        first, second = self._pair_objects(pair, body_poses)
+        return self._collide(first, second)
+
+    def pair_distance(self, pair: int, body_poses: np.ndarray) -> float:
+        """FCL's distance (m) of ``pair`` at body poses (bodies, 4, 4), for a pair not in contact;
+        counts one distance query."""
+        first, second = self._pair_objects(pair, body_poses)
+        self.counter.distance_queries += 1
+        return float(fcl.distance(first, second, self._distance_request, fcl.DistanceResult()))
+
+    def kernel_view(self) -> Any:
+        """The checker as compiled code sees it (:class:`~ompl_balance.collision.kernels.RobotStates`):
+        its arrays, and the exit to :meth:`decide` for the pairs the screening leaves to FCL."""
+        from .kernels import robot_states
+
+        return robot_states(self)
+
     # ------------------------------------------------------------------ internals
+
+    def _pair_objects(self, pair: int, body_poses: np.ndarray) -> tuple[fcl.CollisionObject, fcl.CollisionObject]:
+        """The FCL objects of ``pair``, the link geometries among them placed at ``body_poses``."""
+        environment = len(self._obstacles) * len(self._links)
+        if pair < environment:
+            o, g = divmod(pair, len(self._links))
+            self._place(body_poses, g)
+            return self._links[g], self._obstacles[o]
+        a, b = self._pairs[pair - environment]
+        self._place(body_poses, a)
+        self._place(body_poses, b)
+        return self._links[a], self._links[b]
 
     def _screen_outputs(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Arrays :func:`~ompl_balance.collision.screening.screen` fills for ``n`` configurations:
@@ -199,31 +301,6 @@ class CollisionChecker:
 
     def _collide(self, a: fcl.CollisionObject, b: fcl.CollisionObject) -> bool:
         return fcl.collide(a, b, self._request, fcl.CollisionResult()) > 0
-
-    def _free_exact(self, body_poses: np.ndarray, obstacle_hits: np.ndarray, self_hits: np.ndarray) -> bool:
-        """FCL on the pairs the screening did not clear in one configuration; True if none collides.
-
-        ``body_poses`` (bodies, 4, 4), ``obstacle_hits`` (obstacles, geometries) and
-        ``self_hits`` (pairs) as filled by :meth:`_screen`.
-        """
-        placed: set[int] = set()
-
-        def place(geometry: int) -> None:
-            if geometry not in placed:
-                self._place(body_poses, geometry)
-                placed.add(geometry)
-
-        for o, g in zip(*np.nonzero(obstacle_hits)):
-            place(g)
-            if self._collide(self._links[g], self._obstacles[o]):
-                return False
-        for p in np.flatnonzero(self_hits):
-            a, b = self._pairs[p]
-            place(a)
-            place(b)
-            if self._collide(self._links[a], self._links[b]):
-                return False
-        return True
 
     def _free_reference(self, body_poses: np.ndarray) -> bool:
         """FCL without pre-filter: broad phase against the environment, then every self pair."""

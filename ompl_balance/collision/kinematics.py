@@ -59,6 +59,10 @@ class _MovingJoint:
     shift: float
 
 
+#: Radians (or metres) beyond a joint limit that still count as within it: rounding, not motion.
+LIMIT_TOLERANCE = 1e-12
+
+
 class Chain(NamedTuple):
     """The kinematic chain as arrays, for :func:`chain_poses` (``joints`` moving joints).
 
@@ -276,20 +280,27 @@ class RobotModel:
         disabled = _srdf_disabled_pairs(Path(srdf_path)) if srdf_path is not None else set()
         return RobotModel(urdf, lambda link: _link_shapes(link, resolve), disabled, urdf.robot.name)
 
-    def as_array(self, q: ArrayLike) -> np.ndarray:
-        """``q`` as a float array (n, dof); raises ``ValueError`` for a wrong shape or non-finite values."""
+    def as_array(self, q: ArrayLike, finite: bool = True) -> np.ndarray:
+        """``q`` as a float array (n, dof); raises ``ValueError`` for a wrong shape, and for
+        non-finite values unless ``finite`` is false."""
         q = np.asarray(q, dtype=float)
         q2 = q.reshape(1, -1) if q.ndim == 1 else q
         if q2.ndim != 2 or q2.shape[1] != self.dof:
             raise ValueError(
                 f"configurations must have shape (n, {self.dof}) for joints {self.joint_names}, got {q.shape}"
             )
-        if not np.isfinite(q2).all():
+        if finite and not np.isfinite(q2).all():
             row, col = np.argwhere(~np.isfinite(q2))[0]
             raise ValueError(
                 f"configuration {row} has non-finite value {q2[row, col]} for joint {self.joint_names[col]!r}"
             )
         return q2
+
+    def within_limits(self, q: np.ndarray) -> np.ndarray:
+        """Per configuration of ``q`` (n, dof): every value finite and within its joint's limits
+        (up to :data:`LIMIT_TOLERANCE`, what interpolating between states at a limit can round
+        beyond it), (n,) bool."""
+        return np.all((q >= self.lower - LIMIT_TOLERANCE) & (q <= self.upper + LIMIT_TOLERANCE), axis=1)
 
     def body_poses(self, q: ArrayLike) -> np.ndarray:
         """World poses of the bodies, (n, bodies, 4, 4), for configurations ``q`` (n, dof)."""

@@ -414,8 +414,9 @@ def warm_up() -> None:
 
 def entry_point(kernel: Any, arguments: tuple[Any, ...]) -> Callable[..., Any]:
     """The compiled function of numba ``kernel`` for the types of ``arguments``, compiled (or
-    loaded from numba's cache) now. Calling it skips numba's type dispatch (a few
-    microseconds per call), so later calls must pass arguments of exactly these types."""
-    kernel(*arguments)
-    compiled: Any = kernel.overloads[tuple(numba.typeof(a) for a in arguments)]
+    loaded from numba's cache) now, without calling it. Calling it skips numba's type dispatch
+    (a few microseconds per call), so later calls must pass arguments of exactly these types."""
+    signature = tuple(numba.typeof(a) for a in arguments)
+    kernel.compile(signature)
+    compiled: Any = kernel.overloads[signature]
     return compiled.entry_point

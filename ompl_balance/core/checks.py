@@ -17,7 +17,7 @@ imports them, and numba, only when it compiles for such a view.
 
 A query a kernel cannot decide in compiled code (FCL on a non-convex pair, a user's
 Python callable) leaves through one exit: the kernel's ``objmode`` block looks the Python
-object up by the integer handle the view carries (:func:`register_exit`) and calls it;
+object up by the integer handle the view carries (:func:`exit_handle`) and calls it;
 each such call counts in ``counts[Count.EXITS]``.
 """
 
@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import enum
 import itertools
+import weakref
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -62,25 +63,25 @@ def motion_free(view: Any, a: np.ndarray, b: np.ndarray) -> bool:
     raise TypeError("motion_free is a compiled kernel: call it from numba-compiled code with a checker's view")
 
 
-_EXITS: dict[int, Any] = {}
+_TARGETS: weakref.WeakValueDictionary[int, Any] = weakref.WeakValueDictionary()  # handle -> object
+_HANDLE_OF: weakref.WeakKeyDictionary[Any, int] = weakref.WeakKeyDictionary()  # object -> handle
 _HANDLES = itertools.count(1)
 
 
-def register_exit(target: Any) -> int:
-    """A handle by which compiled code reaches ``target`` (see :func:`exit_target`); release it after use."""
-    handle = next(_HANDLES)
-    _EXITS[handle] = target
+def exit_handle(target: Any) -> int:
+    """The handle by which compiled code reaches ``target`` (see :func:`exit_target`): one per
+    object, held weakly, so registering keeps nothing alive."""
+    handle = _HANDLE_OF.get(target)
+    if handle is None:
+        handle = next(_HANDLES)
+        _TARGETS[handle] = target
+        _HANDLE_OF[target] = handle
     return handle
-
-
-def release_exit(handle: int) -> None:
-    """Forget the object behind ``handle`` (a no-op for a released handle)."""
-    _EXITS.pop(handle, None)
 
 
 def exit_target(handle: int) -> Any:
     """The object registered under ``handle``, for a kernel's ``objmode`` block."""
-    return _EXITS[handle]
+    return _TARGETS[handle]
 
 
 _KERNEL_MODULES: dict[type, str] = {}

@@ -59,13 +59,10 @@ def load(si: ob.SpaceInformation, layout: SpaceLayout, wait: bool) -> None:
     checks = checks_for(si, layout)
     key = view_key((checks.view, layout))
     warm = partial(_warm, checks.view, layout)
-    try:
-        if wait:
-            LOADER.wait(key, warm, _describe(checks))
-        else:
-            LOADER.start(key, warm)
-    finally:
-        checks.close()
+    if wait:
+        LOADER.wait(key, warm, _describe(checks))
+    else:
+        LOADER.start(key, warm)
 
 
 def prepared(solve: Solve, layout: SpaceLayout, room: int, wait: bool, name: str) -> CompiledRun | None:
@@ -77,11 +74,10 @@ def prepared(solve: Solve, layout: SpaceLayout, room: int, wait: bool, name: str
     elif not LOADER.ready(key):
         failure = LOADER.failure(key)
         if failure is None:
-            LOADER.start(key, partial(_warm, checks.view, layout))
-            ou.OMPL_INFORM(f"{name}: the compiled engine is loading in the background; this solve runs on Python")
+            if LOADER.start(key, partial(_warm, checks.view, layout)):
+                ou.OMPL_INFORM(f"{name}: the compiled engine is loading in the background; solving on Python meanwhile")
         else:
             ou.OMPL_WARN(f"{name}: the compiled engine failed to compile ({failure}); solving on Python")
-        checks.close()
         return None
     return partial(_run, solve, checks, layout, room)
 
@@ -91,10 +87,7 @@ def _run(
 ) -> tuple[Any, str]:
     from .driver import run
 
-    try:
-        return run(solve, ptc, checks, layout, room), checks.path
-    finally:
-        checks.close()
+    return run(solve, ptc, checks, layout, room), checks.path
 
 
 def _describe(checks: EngineChecks) -> str:

@@ -53,14 +53,16 @@ class EngineLoader:
         """Why compiling the engine for ``key`` failed, if it did."""
         return self._errors.get(key)
 
-    def start(self, key: Hashable, warm: Callable[[], None]) -> None:
-        """Compile or load the engine for ``key`` in the background (``warm()`` does it), unless under way or done."""
+    def start(self, key: Hashable, warm: Callable[[], None]) -> bool:
+        """Compile or load the engine for ``key`` in the background (``warm()`` does it), unless
+        under way or done; ``True`` when this call started it."""
         with self._lock:
             if key in self._ready or key in self._threads:
-                return
+                return False
             thread = threading.Thread(target=self._warm, args=(key, warm), name="ompl_balance-engine", daemon=True)
             self._threads[key] = thread
         thread.start()
+        return True
 
     def wait(self, key: Hashable, warm: Callable[[], None], what: str) -> None:
         """Make the engine for ``key`` ready now, saying on standard error when that takes more than a second."""

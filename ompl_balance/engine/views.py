@@ -24,7 +24,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from ompl import base as ob
 
-from ..core.checks import exit_target, kernels_in, new_counts, register_exit, release_exit
+from ..core.checks import exit_handle, exit_target, kernels_in, new_counts
 from ..core.layout import SpaceLayout
 
 
@@ -82,23 +82,16 @@ def call_check_motion(handle: int, a: np.ndarray, b: np.ndarray) -> bool:
 
 
 class EngineChecks:
-    """The check view of one solve and what it holds on to (released by :meth:`close`).
+    """The check view of one solve and what it holds on to while the solve runs.
 
     ``path`` says how the checks are made: ``"kernel"`` (compiled kernels, leaving to Python
     only for what they cannot decide) or ``"python"`` (``si.isValid``/``si.checkMotion``).
     """
 
-    def __init__(self, view: Any, path: str, handles: tuple[int, ...] = (), keep: tuple[Any, ...] = ()) -> None:
+    def __init__(self, view: Any, path: str, keep: Any = None) -> None:
         self.view = view
         self.path = path
-        self._handles = handles
-        self._keep = keep
-
-    def close(self) -> None:
-        for handle in self._handles:
-            release_exit(handle)
-        self._handles = ()
-        self._keep = ()
+        self.keep = keep  # the object behind the view's exit handle (held weakly by the registry)
 
 
 def checks_for(si: ob.SpaceInformation, layout: SpaceLayout) -> EngineChecks:
@@ -114,5 +107,4 @@ def checks_for(si: ob.SpaceInformation, layout: SpaceLayout) -> EngineChecks:
         queue = np.empty((2 * longest + 4, 2), dtype=np.int64)
         return EngineChecks(DiscreteMotions(states, layout, np.empty(layout.dim), queue, states.counts), "kernel")
     space_checks = SpaceChecks(si)
-    handle = register_exit(space_checks)
-    return EngineChecks(PythonChecks(handle, new_counts()), "python", (handle,), (space_checks,))
+    return EngineChecks(PythonChecks(exit_handle(space_checks), new_counts()), "python", space_checks)

@@ -14,11 +14,16 @@ R^2 (``"rooms"``) or SE(2) (``"rooms_se2"``, a point robot with a free heading).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
+
+from ..core.checks import kernels_in
+from ..core.counting import CountingValidityChecker
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,38 +91,55 @@ class OccupancyGrid:
         return free
 
 
-class GridValidityChecker(ob.StateValidityChecker):
+@kernels_in("ompl_balance.worlds.grid_kernels")
+class GridKernel(NamedTuple):
+    """An occupancy grid's compiled view (:mod:`ompl_balance.core.checks`): ``free`` (rows, cols)
+    bool, ``origin`` (2,) m, square cells of ``resolution`` m; the position is a state's first two
+    values (a real-vector space's, or SE(2)'s x and y); the checks count in ``counts``."""
+
+    free: np.ndarray
+    origin: np.ndarray
+    resolution: float
+    counts: np.ndarray
+
+
+class _GridCheck:
+    """The validity of an OMPL state's position on a grid: a callable with a compiled view."""
+
+    def __init__(self, grid: OccupancyGrid, position: Callable[[ob.State], tuple[float, float]]) -> None:
+        self.grid = grid
+        self.position = position
+
+    def __call__(self, state: ob.State) -> bool:
+        return self.grid.is_free(*self.position(state))
+
+    def compiled_view(self, counts: np.ndarray) -> GridKernel:
+        grid = self.grid
+        return GridKernel(~grid.occupied, np.array(grid.origin, dtype=float), float(grid.resolution), counts)
+
+
+class GridValidityChecker(CountingValidityChecker):
     """An OMPL validity checker from an :class:`OccupancyGrid`, counting the states it checks.
 
     The state's position is ``(s[0], s[1])`` in a real-vector space (further
     coordinates are ignored) or ``(s.getX(), s.getY())`` in SE(2). A state is valid
     when its position lies in a free cell. ``counters()`` follows
-    :mod:`ompl_balance.core.counting`.
+    :mod:`ompl_balance.core.counting`; the compiled engine checks states with its kernel.
     """
 
     def __init__(self, si: ob.SpaceInformation, grid: OccupancyGrid) -> None:
-        super().__init__(si)
         space = si.getStateSpace()
+        position: Callable[[ob.State], tuple[float, float]]
         if isinstance(space, ob.SE2StateSpace):
-            self._position = lambda state: (state.getX(), state.getY())
+            position = lambda state: (state.getX(), state.getY())  # noqa: E731
         elif isinstance(space, ob.RealVectorStateSpace) and space.getDimension() >= 2:
-            self._position = lambda state: (state[0], state[1])
+            position = lambda state: (state[0], state[1])  # noqa: E731
         else:
             raise TypeError(
                 f"a grid checker needs an SE2 or a real-vector space of dimension >= 2, got {type(space).__name__}"
             )
+        super().__init__(si, _GridCheck(grid, position))
         self.grid = grid
-        self.states_checked = 0
-
-    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
-        self.states_checked += 1
-        return self.grid.is_free(*self._position(state))
-
-    def counters(self) -> dict[str, int]:
-        return {"states_checked": self.states_checked}
-
-    def reset_counters(self) -> None:
-        self.states_checked = 0
 
 
 def rooms_grid(side: float = 40.0, resolution: float = 0.2) -> OccupancyGrid:
