@@ -190,13 +190,15 @@ def test_approx_goal_distance_is_stocks_on_an_impossible_problem():
     ss = WALL.setup()
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     planner.setSeed(4)
+    planner.setEngine("python")  # checks the condition, which counts iterations, every iteration
     ss.setPlanner(planner)
     iterations = iter(range(3000))
     ss.solve(ob.PlannerTerminationCondition(lambda: next(iterations, None) is None))
     ours = float(planner.plannerData().properties["approx goal distance REAL"])
     start, goal = planner._start_tree.states, planner._goal_tree.states
     closest_pair = min(float(np.linalg.norm(goal - point, axis=1).min()) for point in start)
-    assert 0.1 <= closest_pair <= ours  # never below the trees' true distance
+    # never below the trees' true distance (but for the six digits of C++'s default format)
+    assert 0.1 <= closest_pair <= ours * (1 + 5e-6)
     assert stock >= 0.1 and math.isclose(ours, stock, rel_tol=0.25), (ours, stock)
 
 

@@ -342,11 +342,13 @@ def test_impossible_problem_times_out_on_time():
     assert elapsed < 0.2 + 2.0
 
 
-def test_the_termination_condition_is_checked_once_per_iteration():
+def test_the_python_engine_checks_the_termination_condition_once_per_iteration():
+    """(The compiled engine checks it between slices of about a millisecond: tests/test_engine.py.)"""
     walled = (*get_problem("narrow_gap").boxes[0][:3], 1.0)
     ss = get_problem("narrow_gap").setup()
     ss.setStateValidityChecker(BoxWorld2D((walled,)))
     planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("python")
     ss.setPlanner(planner)
     ss.setup()
     asked = 0
@@ -428,6 +430,7 @@ ROUND_TRIPS = {
     "goal_bias": ("0.25", "0.25"),
     "min_quality": ("0.1", "0.1"),
     "uniform_rate": ("0.2", "0.2"),
+    "engine": ("python", "python"),
 }
 
 
@@ -441,6 +444,7 @@ def test_every_parameter_round_trips():
     assert planner.getRange() == 0.125 and planner.getIntermediateStates() is True
     assert planner.getBalanceTreeSizes() is False and planner.getMaxTreeSizeRatio() == 2.5
     assert params.getRangeSuggestion("max_tree_size_ratio") == "0.:0.05:10."
+    assert params.getRangeSuggestion("engine") == "auto,compiled,python"
 
 
 @pytest.mark.parametrize(

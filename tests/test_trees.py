@@ -52,9 +52,9 @@ def test_array_tree_nearest_of_an_empty_tree_is_refused():
 
 
 def test_kernels_load_only_where_a_tree_needs_them():
-    """``import ompl_balance``, a planner's setup() and a solve whose trees stay small load
-    neither numba nor the compiled scans; a tree reaching COMPILED_SCANS_FROM nodes starts
-    loading them in the background, and scans with them once they are there."""
+    """``import ompl_balance``, a Python-engine planner's setup() and a solve whose trees stay
+    small load neither numba nor the compiled scans; a tree reaching COMPILED_SCANS_FROM nodes
+    starts loading them in the background, and scans with them once they are there."""
     script = (
         "import sys, time\n"
         "import numpy as np\n"
@@ -67,6 +67,7 @@ def test_kernels_load_only_where_a_tree_needs_them():
         "problem = ompl_balance.get_problem('narrow_gap')\n"
         "ss = problem.setup()\n"
         "planner = ompl_balance.BalancedRRTConnect(ss.getSpaceInformation())\n"
+        "planner.setEngine('python')\n"
         "ss.setPlanner(planner)\n"
         "ss.setup()\n"
         "print(*loaded())\n"
