@@ -1,0 +1,445 @@
+"""The compiled engine against the Python engine, and the compiled engine's contract.
+
+Where the two engines share one random stream (real-vector spaces, SE(2)), the compiled one
+must make the same trees, the same path and the same counts as the Python one, for every
+policy and every kind of check; SE(3) and the termination condition, Ctrl-C and a fresh
+process's first solve are tested on their own.
+"""
+
+from __future__ import annotations
+
+import math
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from ompl_balance import BalancedRRTConnect
+from ompl_balance.core.layout import layout_for
+from ompl_balance.planners import PRESETS
+from ompl_balance.worlds.boxes import BoxWorld2D, get_problem
+from ompl_balance.worlds.occupancy import rooms_problem
+
+ou.setLogLevel(ou.LOG_WARN)
+
+#: Every preset but the Gaussian passage sampler's (a valid-state sampler: the Python engine only).
+COMPILED_PRESETS = [name for name in PRESETS if name != "GaussianPassageRRTConnect"]
+IGNORED = {"time", "engine", "checks", "exits"}
+
+
+def solve(make_setup, engine, planner_class=BalancedRRTConnect, seed=3, params=None, limit=20.0, solves=1, **kwargs):
+    """Solve ``make_setup()`` on ``engine`` ``solves`` times in a row; returns (stats, trees, path) per solve."""
+    ss = make_setup()
+    planner = planner_class(ss.getSpaceInformation(), **kwargs)
+    assert planner.params().setParams({"engine": engine, "seed": str(seed), **(params or {})})
+    ss.setPlanner(planner)
+    outcomes = []
+    for _ in range(solves):
+        status = ss.solve(limit)
+        stats = {key: value for key, value in planner.stats.as_dict().items() if key not in IGNORED}
+        assert planner.stats.engine == engine
+        trees = [tree.states.copy() for tree in (planner._start_tree, planner._goal_tree)]
+        parents = [tree.parents[: len(tree)].copy() for tree in (planner._start_tree, planner._goal_tree)]
+        path = None
+        if status == ob.PlannerStatus.EXACT_SOLUTION:
+            p = ss.getSolutionPath()
+            path = [points(ss, p.getState(i)) for i in range(p.getStateCount())]
+        outcomes.append((str(status), stats, trees, parents, path))
+    return outcomes
+
+
+def points(ss, state):
+    """The flat values of an OMPL state of ``ss``'s space."""
+    from ompl_balance.core.layout import state_reader
+
+    return state_reader(ss.getStateSpace())(state)
+
+
+def assert_same_run(python, compiled):
+    for (status, stats, trees, parents, path), (status2, stats2, trees2, parents2, path2) in zip(python, compiled):
+        assert status == status2
+        assert stats == stats2
+        for a, b in zip(trees, trees2):
+            np.testing.assert_array_equal(a, b)
+        for a, b in zip(parents, parents2):
+            np.testing.assert_array_equal(a, b)
+        assert path == path2
+
+
+# -- the same trees ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("problem", ["bug_trap", "maze"])
+@pytest.mark.parametrize("preset", COMPILED_PRESETS)
+def test_every_preset_makes_the_python_engines_trees(preset, problem):
+    make = get_problem(problem).setup
+    python = solve(make, "python", PRESETS[preset])
+    compiled = solve(make, "compiled", PRESETS[preset])
+    assert python[0][0] == "Exact solution"
+    assert_same_run(python, compiled)
+
+
+@pytest.mark.parametrize(
+    "params",
+    [
+        {"balance_tree_sizes": "1", "max_tree_size_ratio": "0.5", "range": "0.05"},
+        {"nearest_policy": "exhausted", "exhausted_after": "2", "sample_policy": "goal_bias", "goal_bias": "0.3"},
+        {"nearest_policy": "exhaustion", "sample_policy": "neighbour_quality", "min_quality": "0.2"},
+        {"swap_policy": "balance_steps", "swap_steps": "3", "sample_policy": "goal_ball", "uniform_rate": "0.0"},
+    ],
+)
+def test_policy_combinations_make_the_python_engines_trees(params):
+    make = get_problem("bug_trap").setup
+    assert_same_run(solve(make, "python", params=params), solve(make, "compiled", params=params))
+
+
+def test_intermediate_states_and_repeated_solves_without_clear():
+    make = get_problem("narrow_gap").setup
+    kwargs = {"addIntermediateStates": True}
+    python = solve(make, "python", solves=3, **kwargs)
+    compiled = solve(make, "compiled", solves=3, **kwargs)
+    assert_same_run(python, compiled)
+    assert python[2][1]["start_tree_size"] > python[0][1]["start_tree_size"]  # the trees carry over
+
+
+def several_goals_setup():
+    ss = get_problem("maze").setup()
+    goals = ob.GoalStates(ss.getSpaceInformation())
+    for x, y in ((0.95, 0.95), (0.95, 0.05), (0.7, 0.95)):
+        goal = ss.getStateSpace().allocState()
+        goal[0], goal[1] = x, y
+        goals.addState(goal)
+    ss.setGoal(goals)
+    return ss
+
+
+def test_goal_states_are_fed_as_the_python_engine_feeds_them():
+    assert_same_run(solve(several_goals_setup, "python"), solve(several_goals_setup, "compiled"))
+
+
+def shell_setup():
+    """A Python callable checker (through si.isValid and si.checkMotion): a 4-D shell around the start."""
+    space = ob.RealVectorStateSpace(4)
+    space.setBounds(-1.0, 1.0)
+    ss = og.SimpleSetup(space)
+
+    def free(state) -> bool:
+        values = [state[i] for i in range(4)]
+        radius = math.sqrt(sum(v * v for v in values))
+        return not 0.3 <= radius <= 0.4 or -values[0] / radius > 0.9
+
+    ss.setStateValidityChecker(free)
+    start, goal = space.allocState(), space.allocState()
+    for i in range(4):
+        start[i] = goal[i] = 0.0
+    goal[0] = 0.8
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
+def test_a_python_checker_gives_the_same_trees_through_the_space_information():
+    python = solve(shell_setup, "python")
+    compiled = solve(shell_setup, "compiled")
+    assert_same_run(python, compiled)
+
+
+@pytest.mark.parametrize("se2", [False, True])
+def test_occupancy_grids_in_the_plane_and_in_se2(se2):
+    make = rooms_problem(se2=se2).setup
+    assert_same_run(solve(make, "python"), solve(make, "compiled"))
+
+
+def test_the_kernels_and_the_path_they_take_are_reported():
+    ss = get_problem("bug_trap").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    ss.setPlanner(planner)
+    assert ss.solve(10.0)
+    assert (planner.stats.engine, planner.stats.checks, planner.stats.exits) == ("compiled", "kernel", 0)
+    ss = shell_setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    ss.setPlanner(planner)
+    assert ss.solve(10.0)
+    assert (planner.stats.engine, planner.stats.checks) == ("compiled", "python")
+    assert planner.stats.exits >= planner.stats.motions_checked  # a call out per motion (and goal state)
+
+
+def robot_setup(motion, scene="arm3", problem_index=0):
+    """A robot problem with the package's checker: the 3-joint test arm among four obstacles (a
+    start and goal on either side of the wall) or a MotionBenchMaker Panda problem."""
+    from ompl_balance.collision.checker import CollisionChecker
+    from ompl_balance.validity import setup_robot, space_for
+
+    if scene == "arm3":
+        from test_validity import arm3_scene
+
+        robot, environment, _ = arm3_scene()
+
+        def make():
+            checker = CollisionChecker(robot, environment)
+            ss = og.SimpleSetup(space_for(robot))
+            setup_robot(ss, checker, motion=motion)
+            si = ss.getSpaceInformation()
+            start, goal = si.allocState(), si.allocState()
+            for i, (a, b) in enumerate(zip((0.0, -1.0, 0.1), (2.5, 1.0, 0.1))):
+                start[i], goal[i] = a, b
+            ss.setStartAndGoalStates(start, goal)
+            return ss
+
+        return make
+    from ompl_balance.collision.robots import load_panda_vamp
+    from ompl_balance.worlds.mbm import load_mbm
+
+    robot = load_panda_vamp()
+    problem = load_mbm(scene, robot.joint_names)[problem_index]
+    return lambda: problem.simple_setup(robot, CollisionChecker(robot, problem.environment), motion=motion)
+
+
+@pytest.mark.parametrize("motion", ["certified", "discrete"])
+def test_the_robot_checkers_kernels_give_the_python_engines_trees(motion):
+    make = robot_setup(motion)
+    for seed in (1, 2):
+        python = solve(make, "python", seed=seed)
+        compiled = solve(make, "compiled", seed=seed)
+        assert python[0][0] == "Exact solution"
+        assert_same_run(python, compiled)
+
+
+@pytest.mark.parametrize("motion", ["certified", "discrete"])
+def test_a_panda_problem_on_both_engines(motion):
+    make = robot_setup(motion, "bookshelf_small", 3)
+    assert_same_run(solve(make, "python", seed=4), solve(make, "compiled", seed=4))
+
+
+# -- SE(3) and the flat layouts' geometry ----------------------------------------------------------
+
+
+def se3_setup():
+    """A point robot in SE(3) (its rotation free) through a wall with a hole, a Python checker."""
+    space = ob.SE3StateSpace()
+    bounds = ob.RealVectorBounds(3)
+    bounds.setLow(-1.0)
+    bounds.setHigh(1.0)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: not (-0.05 < s.getX() < 0.05 and (abs(s.getY()) > 0.2 or abs(s.getZ()) > 0.2)))
+    start, goal = space.allocState(), space.allocState()
+    start.setXYZ(-0.8, 0.0, 0.0)
+    goal.setXYZ(0.8, 0.3, -0.3)
+    start.rotation().setIdentity()
+    goal.rotation().setAxisAngle(0.0, 0.0, 1.0, 2.5)
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
+@pytest.mark.parametrize("space_kind", ["SE2", "SE3", "SO2", "SO3", "compound"])
+def test_flat_layouts_have_ompls_metric_and_interpolation(space_kind):
+    from ompl_balance.core import compiled_spaces, layout
+
+    if space_kind == "SE2":
+        space = ob.SE2StateSpace()
+        bounds = ob.RealVectorBounds(2)
+        bounds.setLow(-2.0)
+        bounds.setHigh(3.0)
+        space.setBounds(bounds)
+    elif space_kind == "SE3":
+        space = se3_setup().getStateSpace()
+    elif space_kind == "SO2":
+        space = ob.SO2StateSpace()
+    elif space_kind == "SO3":
+        space = ob.SO3StateSpace()
+    else:
+        space = ob.CompoundStateSpace()
+        inner = ob.RealVectorStateSpace(2)
+        inner.setBounds(0.0, 4.0)
+        space.addSubspace(inner, 0.7)
+        space.addSubspace(ob.SO2StateSpace(), 0.3)
+        space.addSubspace(ob.SO3StateSpace(), 1.9)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda s: True)
+    si.setStateValidityCheckingResolution(0.013)
+    si.setup()
+    flat = layout_for(space)
+    assert flat is not None
+    sampler = si.allocStateSampler()
+    a, b, mid = si.allocState(), si.allocState(), si.allocState()
+    read = layout.state_reader(space)
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        sampler.sampleUniform(a)
+        sampler.sampleUniform(b)
+        x, y = np.array(read(a)), np.array(read(b))
+        t = float(rng.uniform())
+        space.interpolate(a, b, t, mid)
+        for distance, interpolate, count in (
+            (layout.distance, lambda p, q, s: layout.interpolate(flat, p, q, s), layout.segment_count),
+            (compiled_spaces.distance, None, compiled_spaces.segment_count),
+        ):
+            assert distance(flat, x, y) == pytest.approx(si.distance(a, b), rel=1e-12, abs=1e-12)
+            assert count(flat, x, y) == space.validSegmentCount(a, b)
+            if interpolate is not None:
+                np.testing.assert_allclose(interpolate(x, y, t), read(mid), rtol=0, atol=1e-12)
+        out = np.empty(flat.dim)
+        compiled_spaces.interpolate(flat, x, y, t, out)
+        np.testing.assert_allclose(out, read(mid), rtol=0, atol=1e-12)
+    # uniform samples: inside the bounds, unit quaternions, the same from numpy and compiled code
+    uniforms = rng.random((64, flat.total_draws))
+    samples = layout.samples_from_uniforms(flat, uniforms)
+    for row in range(64):
+        out = np.empty(flat.dim)
+        compiled_spaces.sample_from_uniforms(flat, uniforms[row], out)
+        np.testing.assert_allclose(out, samples[row], rtol=0, atol=1e-15)
+        space.copyFromReals(a, samples[row].tolist())
+        assert space.satisfiesBounds(a)
+
+
+def test_se3_plans_on_both_engines_with_valid_paths():
+    for engine in ("python", "compiled"):
+        for seed in (1, 2, 3):
+            ss = se3_setup()
+            planner = BalancedRRTConnect(ss.getSpaceInformation())
+            planner.setEngine(engine)
+            planner.setSeed(seed)
+            ss.setPlanner(planner)
+            assert ss.solve(20.0) == ob.PlannerStatus.EXACT_SOLUTION
+            path = ss.getSolutionPath()
+            assert path.check()  # OMPL's own validator on the path's motions
+            assert planner.stats.engine == engine
+
+
+def test_se3_trees_match_where_the_math_library_agrees_with_numpy():
+    """SE(3)'s quaternions go through acos and sin: numpy's vectorised acos may round a distance
+    differently in its last bit from the C library's, which could reorder two nearly equally
+    near nodes; on the seeds here the two engines agree exactly."""
+    python = solve(se3_setup, "python", seed=5)
+    compiled = solve(se3_setup, "compiled", seed=5)
+    assert python[0][1] == compiled[0][1]
+
+
+# -- termination, interruption, first use ---------------------------------------------------------
+
+
+def impossible_setup():
+    walled = (*get_problem("narrow_gap").boxes[0][:3], 1.0)
+    ss = get_problem("narrow_gap").setup()
+    ss.setStateValidityChecker(BoxWorld2D((walled,)))
+    return ss
+
+
+def test_a_time_limit_ends_the_compiled_solve_on_time():
+    ss = impossible_setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    ss.setPlanner(planner)
+    ss.setup()
+    began = time.perf_counter()
+    assert planner.solve(0.5) == ob.PlannerStatus.TIMEOUT
+    assert 0.5 <= time.perf_counter() - began < 1.0
+    assert planner.stats.iterations > 100
+
+
+def test_the_compiled_engine_polls_the_condition_every_few_milliseconds_and_stops_on_an_event():
+    ss = impossible_setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    ss.setPlanner(planner)
+    ss.setup()
+    polled: list[float] = []
+    event = {"set": False}
+
+    def stop() -> bool:
+        polled.append(time.perf_counter())
+        if len(polled) == 200:
+            event["set"] = True
+        return event["set"]
+
+    assert planner.solve(stop) == ob.PlannerStatus.TIMEOUT
+    assert len(polled) == 200  # stopped at the first poll after the event
+    gaps = np.diff(polled[20:])  # (the first slices are short while the engine sizes them)
+    assert np.median(gaps) < 0.005
+
+
+def test_ctrl_c_interrupts_a_compiled_solve():
+    script = textwrap.dedent(
+        """
+        import sys
+        from ompl import util as ou
+        ou.setLogLevel(ou.LOG_WARN)
+        sys.path.insert(0, "tests")
+        from test_engine import impossible_setup
+        from ompl_balance import BalancedRRTConnect
+        ss = impossible_setup()
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        planner.setEngine("compiled")
+        ss.setPlanner(planner)
+        ss.setup()
+        print("solving", flush=True)
+        try:
+            planner.solve(60.0)
+        except KeyboardInterrupt:
+            print("interrupted", planner.stats is None or planner.stats.iterations, flush=True)
+        """
+    )
+    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert process.stdout is not None
+    assert process.stdout.readline().strip() == "solving"
+    time.sleep(1.0)
+    process.send_signal(signal.SIGINT)
+    began = time.perf_counter()
+    out, _ = process.communicate(timeout=30)
+    assert "interrupted" in out
+    assert time.perf_counter() - began < 10.0
+
+
+def test_a_fresh_processs_first_half_second_solve_returns_in_time():
+    script = textwrap.dedent(
+        """
+        import time
+        from ompl import util as ou
+        ou.setLogLevel(ou.LOG_WARN)
+        from ompl_balance import BalancedRRTConnect, get_problem
+        from ompl_balance.worlds.boxes import BoxWorld2D
+        walled = (*get_problem("narrow_gap").boxes[0][:3], 1.0)
+        ss = get_problem("narrow_gap").setup()
+        ss.setStateValidityChecker(BoxWorld2D((walled,)))
+        ss.setPlanner(BalancedRRTConnect(ss.getSpaceInformation()))
+        began = time.perf_counter()
+        ss.solve(0.5)
+        print(time.perf_counter() - began)
+        """
+    )
+    elapsed = float(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout)
+    assert elapsed < 1.0
+
+
+# -- what the compiled engine refuses -------------------------------------------------------------
+
+
+def test_compiled_refuses_a_valid_state_sampler_and_spaces_without_a_layout():
+    ss = get_problem("open").setup()
+    planner = PRESETS["GaussianPassageRRTConnect"](ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    with pytest.raises(ValueError, match="valid_sampler"):
+        planner.setup()
+    space = ob.DubinsStateSpace(0.2)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0.0)
+    bounds.setHigh(1.0)
+    space.setBounds(bounds)
+    assert layout_for(space) is None
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: True)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    with pytest.raises(ValueError, match="DubinsStateSpace"):
+        planner.setup()
+    planner.setEngine("auto")  # auto plans on Python there
+    planner.setup()
