@@ -63,48 +63,61 @@ def euclidean_within(  # pragma: no cover (compiled)
     return count
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def is_euclidean(layout: SpaceLayout) -> bool:  # pragma: no cover (compiled)
     """One real-vector leaf of weight 1 (:attr:`SpaceLayout.euclidean`)."""
     return len(layout.kind) == 1 and layout.kind[0] == _REAL and layout.weight[0] == 1.0
 
 
-@njit(cache=True)
-def leaf_distance(layout: SpaceLayout, leaf: int, a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover
-    """OMPL's distance of flat states ``a``, ``b`` in leaf ``leaf``'s own space (unweighted)."""
+@njit(cache=True, inline="always")
+def leaf_distance(
+    layout: SpaceLayout, leaf: int, states: np.ndarray, row: int, b: np.ndarray
+) -> float:  # pragma: no cover
+    """OMPL's distance of ``states[row]`` and ``b`` in leaf ``leaf``'s own space (unweighted).
+
+    (A row index rather than a row: a row would be a new array, counted in and out of
+    numba's reference counts, for each of the many distances a scan takes.)
+    """
     start = layout.offset[leaf]
     kind = layout.kind[leaf]
     if kind == _REAL:
         squared = 0.0
         for k in range(start, start + layout.size[leaf]):
-            offset = b[k] - a[k]
+            offset = b[k] - states[row, k]
             squared += offset * offset
         return math.sqrt(squared)
     if kind == _SO2:
-        d = abs(a[start] - b[start])
+        d = abs(states[row, start] - b[start])
         return 2.0 * math.pi - d if d > math.pi else d
-    dot = a[start] * b[start]
+    dot = states[row, start] * b[start]
     for k in range(start + 1, start + 4):
-        dot += a[k] * b[k]
+        dot += states[row, k] * b[k]
     dot = abs(dot)
     return 0.0 if dot > 1.0 - QUATERNION_TOLERANCE else math.acos(dot)
 
 
-@njit(cache=True)
-def distance(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover (compiled)
-    """OMPL's distance of flat states ``a`` and ``b``: the weighted sum over the leaves."""
+@njit(cache=True, inline="always")
+def row_distance(layout: SpaceLayout, states: np.ndarray, row: int, b: np.ndarray) -> float:  # pragma: no cover
+    """OMPL's distance of ``states[row]`` and flat state ``b``: the weighted sum over the leaves."""
     total = 0.0
     for leaf in range(len(layout.kind)):
-        total += layout.weight[leaf] * leaf_distance(layout, leaf, a, b)
+        total += layout.weight[leaf] * leaf_distance(layout, leaf, states, row, b)
     return total
+
+
+@njit(cache=True)
+def distance(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover (compiled)
+    """OMPL's distance of flat states ``a`` and ``b``."""
+    return row_distance(layout, a.reshape((1, a.shape[0])), 0, b)
 
 
 @njit(cache=True)
 def segment_count(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> int:  # pragma: no cover (compiled)
     """OMPL's ``validSegmentCount(a, b)``: the largest over the leaves of ``factor * ceil(d / segment)``."""
     count = 0
+    rows = a.reshape((1, a.shape[0]))
     for leaf in range(len(layout.kind)):
-        d = leaf_distance(layout, leaf, a, b)
+        d = leaf_distance(layout, leaf, rows, 0, b)
         count = max(count, layout.factor[leaf] * math.ceil(d / layout.segment[leaf]))
     return count
 
@@ -162,7 +175,7 @@ def equal(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> bool:  # pragma:
         elif kind == _SO2:
             if not abs(a[start] - b[start]) < 2.0 * _EPS:
                 return False
-        elif not leaf_distance(layout, leaf, a, b) < _EPS:
+        elif not leaf_distance(layout, leaf, a.reshape((1, a.shape[0])), 0, b) < _EPS:
             return False
     return True
 
@@ -198,7 +211,7 @@ def nearest(
         return best, math.sqrt(squared)
     best, best_distance = 0, np.inf
     for i in range(size):
-        d = distance(layout, states[i], query)
+        d = row_distance(layout, states, i, query)
         if d < best_distance:
             best, best_distance = i, d
     return best, best_distance
@@ -214,4 +227,4 @@ def distances_to(
             out[i] = math.sqrt(_squared_distance(states, i, query))
         return
     for i in range(size):
-        out[i] = distance(layout, states[i], query)
+        out[i] = row_distance(layout, states, i, query)

@@ -23,6 +23,7 @@ from ..core.trees import ArrayTree
 from ..policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause
 from . import loop
 from .events import Grow, GrowStep, TreeChoiceEvent
+from .index import new_index
 from .loop import Real, Record, Slot, Stop
 from .solve import Solve
 from .views import EngineChecks
@@ -63,6 +64,7 @@ class _Arrays:
         self.room = room
         dim = layout.dim
         self.costs = [np.empty(0), np.empty(0)]
+        self.indexes = [new_index(layout, 0), new_index(layout, 0)]
         self.loop = loop.Loop(
             sizes=np.zeros(2, dtype=np.int64),
             ints=np.zeros(Slot.COUNT, dtype=np.int64),
@@ -90,10 +92,17 @@ class _Arrays:
             failures = self.solve.failures[tree]
             failures.reserve(capacity)
             if len(self.costs[t]) < capacity:
-                grown = np.empty(capacity)
-                grown[: len(self.costs[t])] = self.costs[t]
-                self.costs[t] = grown
-            trees.append(loop.Tree(storage.states, storage.parents, storage.roots, failures.array, self.costs[t]))
+                self.costs[t] = _grown(self.costs[t], capacity)
+            index = self.indexes[t]
+            if len(index.order) < capacity:
+                self.indexes[t] = index = index._replace(
+                    order=_grown(index.order, capacity),
+                    points=_grown(index.points, capacity),
+                    axis=_grown(index.axis, capacity),
+                )
+            trees.append(
+                loop.Tree(storage.states, storage.parents, storage.roots, failures.array, self.costs[t], index)
+            )
             self.loop.sizes[t] = len(tree)
         record = self.loop.record
         if len(record) and len(record) - self.loop.ints[Slot.RECORDED] < self.room + 2:
@@ -205,6 +214,7 @@ def warm_up(view: object, layout: SpaceLayout) -> None:
         np.zeros(1, dtype=np.int64),
         np.zeros(1, dtype=np.int64),
         np.zeros(1),
+        new_index(layout, 1),
     )
     arrays = loop.Loop(
         sizes=np.zeros(2, dtype=np.int64),

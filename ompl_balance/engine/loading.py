@@ -12,6 +12,7 @@ when the wait exceeds a second.
 from __future__ import annotations
 
 import os
+import pickle
 import sys
 import threading
 import time
@@ -88,11 +89,31 @@ class EngineLoader:
 
     def _warm(self, key: Hashable, warm: Callable[[], None]) -> None:
         try:
-            warm()
+            try:
+                warm()
+            except (AttributeError, ImportError, EOFError, pickle.UnpicklingError):
+                # numba's cache index names classes by module: one written by another version
+                # of the package may name what no longer exists. Forget the package's cached
+                # kernels (numba compiles them again) and try once more.
+                forget_cached_kernels()
+                warm()
         except BaseException as error:  # reported by wait(); auto keeps the Python engine
             self._errors[key] = error
             return
         self._ready.add(key)
+
+
+def forget_cached_kernels() -> None:
+    """Empty numba's on-disk cache index of every compiled function of the package loaded so far."""
+    from numba.core.dispatcher import Dispatcher
+
+    for name, module in list(sys.modules.items()):
+        if not name.startswith("ompl_balance") or module is None:
+            continue
+        for value in list(vars(module).values()):
+            cache = getattr(value, "_cache", None) if isinstance(value, Dispatcher) else None
+            if cache is not None:
+                cache.flush()
 
 
 LOADER = EngineLoader()

@@ -27,9 +27,10 @@ from numba.extending import register_jitable
 
 from .. import policies
 from ..core.checks import motion_free, state_free
-from ..core.compiled_spaces import distance, equal, interpolate, nearest, sample_from_uniforms, segment_count
+from ..core.compiled_spaces import distance, equal, interpolate, row_distance, sample_from_uniforms, segment_count
 from ..core.layout import SpaceLayout
 from .events import Grow
+from .index import KDIndex, indexed_nearest
 
 register_jitable(policies.tree_size_ratio)  # callable from the compiled choose_tree
 choose_tree = njit(cache=True)(policies.choose_tree)
@@ -115,13 +116,14 @@ class Settings(NamedTuple):
 
 class Tree(NamedTuple):
     """One tree's arrays (capacity rows): states (capacity, dim), parents, roots, failed
-    extensions per node, and neighbour-quality costs."""
+    extensions per node, neighbour-quality costs, and its nearest-neighbour :class:`~ompl_balance.engine.index.KDIndex`."""
 
     states: np.ndarray
     parents: np.ndarray
     roots: np.ndarray
     failures: np.ndarray
     costs: np.ndarray
+    neighbours: KDIndex  # the nearest-neighbour index
 
 
 class Loop(NamedTuple):
@@ -174,13 +176,13 @@ def _find_nearest(
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
     """The node the nearest policy extends towards ``target``, and its distance (first on ties)."""
     if settings.nearest_policy != _EXHAUSTION:
-        node, best = nearest(layout, tree.states, size, target)
+        node, best = indexed_nearest(tree.neighbours, layout, tree.states, size, target)
         if settings.nearest_policy == _EUCLIDEAN or tree.failures[node] < settings.exhausted_after:
             return node, best  # the nearest of all is not exhausted: no need to rank
     found, found_distance, score = NO_NODE, np.inf, np.inf
     closest, closest_distance = 0, np.inf
     for i in range(size):
-        d = distance(layout, tree.states[i], target)
+        d = row_distance(layout, tree.states, i, target)
         if d < closest_distance:
             closest, closest_distance = i, d
         if settings.nearest_policy == _EXHAUSTED:
@@ -436,7 +438,7 @@ def run(
         if connected == _REACHED:
             gap = 0.0
         elif settings.nearest_policy != _EUCLIDEAN:
-            gap = nearest(layout, trees[o].states, sizes[o], reach)[1]
+            gap = indexed_nearest(trees[o].neighbours, layout, trees[o].states, sizes[o], reach)[1]
         loop.reals[Real.TREE_GAP] = min(loop.reals[Real.TREE_GAP], gap)
         collided = connected == _TRAPPED
         ints[Slot.COLLIDED] = 1 if collided else 0
