@@ -33,7 +33,7 @@ from .collision.kernels import (
     robot_discrete_motions,
 )
 from .collision.kinematics import RobotModel
-from .collision.screening import entry_point
+from .core.compiled_calls import entry_point
 from .core.layout import layout_for
 
 #: The motion validators :func:`setup_robot` installs, by name.

@@ -72,6 +72,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.checks import exit_handle
+from ..core.compiled_calls import entry_point
 from .advancement import (
     DISTANCE_TOLERANCE,
     MIN_TRAVEL,
@@ -87,7 +88,6 @@ from .advancement import (
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
 from .kernels import CertifiedMotions, certified_motion_free, robot_states
-from .screening import entry_point
 from .travel import travel_weights
 
 #: Travel (m) to which ``check(..., last_valid=True)`` refines the edge around its first

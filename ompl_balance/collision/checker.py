@@ -30,10 +30,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..core.checks import Count, new_counts
+from ..core.compiled_calls import entry_point
 from .environment import Environment
 from .geometry import fcl_transform
 from .kinematics import RobotModel
-from .screening import Volumes, build_volumes, entry_point, screen
+from .screening import Volumes, build_volumes, screen
 
 
 class _Count:

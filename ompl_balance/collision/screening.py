@@ -30,11 +30,10 @@ cost tens of microseconds of per-call overhead at these array sizes.
 from __future__ import annotations
 
 import weakref
-from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any, NamedTuple
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, NamedTuple
 
 import fcl
-import numba
 import numpy as np
 from numba import njit
 
@@ -410,13 +409,3 @@ def warm_up() -> None:
     q, poses = np.zeros((1, 1)), np.zeros((1, 2, 4, 4))
     screen(q, chain, volumes, poses, np.zeros((1, 0, 0), dtype=bool), np.zeros((1, 0), dtype=bool))
     _chain_poses_batch(q, chain, poses)
-
-
-def entry_point(kernel: Any, arguments: tuple[Any, ...]) -> Callable[..., Any]:
-    """The compiled function of numba ``kernel`` for the types of ``arguments``, compiled (or
-    loaded from numba's cache) now, without calling it. Calling it skips numba's type dispatch
-    (a few microseconds per call), so later calls must pass arguments of exactly these types."""
-    signature = tuple(numba.typeof(a) for a in arguments)
-    kernel.compile(signature)
-    compiled: Any = kernel.overloads[signature]
-    return compiled.entry_point

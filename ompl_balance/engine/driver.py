@@ -12,11 +12,14 @@ counts and loop record hold what the compiled loop did, as if the Python engine 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from ompl import base as ob
 
 from ..core.checks import Count
+from ..core.compiled_calls import entry_point
 from ..core.layout import SpaceLayout
 from ..core.spaces import SAMPLE_BLOCK
 from ..core.trees import ArrayTree
@@ -24,12 +27,14 @@ from ..policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCau
 from . import loop
 from .events import Grow, GrowStep, TreeChoiceEvent
 from .index import new_index
+from .loading import view_key
 from .loop import Real, Record, Slot, Stop
 from .solve import Solve
 from .views import EngineChecks
 
-#: A slice of iterations lasts about this long (s): the termination condition's polling period.
-SLICE_SECONDS = 1e-3
+#: A slice of iterations lasts about this long (s): the termination condition's polling period
+#: (a slice costs some 50 microseconds of Python around it).
+SLICE_SECONDS = 2e-3
 #: Iterations of the largest slice.
 MAX_BUDGET = 1 << 16
 
@@ -118,6 +123,19 @@ class _Arrays:
             tree.adopt(int(self.loop.sizes[t]))
 
 
+_RUNNERS: dict[Any, Callable[..., int]] = {}
+
+
+def _runner(*arguments: Any) -> Callable[..., int]:
+    """:func:`ompl_balance.engine.loop.run` for the types of ``arguments``, called without numba's
+    type dispatch (tens of microseconds a call; working the types out takes milliseconds, so it
+    is done once per kind of view and layout)."""
+    key = view_key(arguments[:2])
+    if key not in _RUNNERS:
+        _RUNNERS[key] = entry_point(loop.run, arguments)
+    return _RUNNERS[key]
+
+
 def _grown(array: np.ndarray, rows: int) -> np.ndarray:
     grown = np.empty((rows, *array.shape[1:]), dtype=array.dtype)
     grown[: len(array)] = array
@@ -139,12 +157,13 @@ def run(
     exits_before = int(checks.view.counts[Count.EXITS])
     status = ob.PlannerStatus.TIMEOUT
     budget = 1
+    run_slice = _runner(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
     try:
         while not ptc():
             ints[Slot.SAMPLED_GOALS] = solve.inputs.getSampledGoalsCount()
             ints[Slot.MORE_GOALS] = solve.inputs.haveMoreGoalStates()
             began = time.perf_counter()
-            stop = loop.run(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
+            stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
             arrays.adopt()
             solve.progress.iterations = int(ints[Slot.ITERATIONS])
             if stop == Stop.BUDGET:

@@ -1,0 +1,24 @@
+"""Calling compiled (numba) functions from Python without numba's type dispatch.
+
+A call to a numba function from Python first works out the numba type of every argument;
+for named tuples of arrays (the package's views, trees and layouts) that is done in Python
+and costs tens of microseconds per call. :func:`entry_point` compiles a function for fixed
+argument types once and returns the compiled function itself, so later calls skip it (and
+must pass arguments of exactly those types).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numba
+
+
+def entry_point(kernel: Any, arguments: tuple[Any, ...]) -> Callable[..., Any]:
+    """The compiled function of numba ``kernel`` for the types of ``arguments``, compiled (or
+    loaded from numba's cache) now, without calling it."""
+    signature = tuple(numba.typeof(a) for a in arguments)
+    kernel.compile(signature)
+    compiled: Any = kernel.overloads[signature]
+    return compiled.entry_point
