@@ -151,10 +151,11 @@ class _ScanLoader:
 
     def loaded(self) -> ModuleType | None:
         if self.scans is None and self.thread is None:
-            if (
-                "ompl_balance.core.compiled_spaces" in sys.modules
-            ):  # imported by someone else, e.g. a forkserver's preload
-                return self.load()
+            module = sys.modules.get("ompl_balance.core.compiled_spaces")
+            if module is not None and not getattr(module.__spec__, "_initializing", False):
+                return self.load()  # imported by someone else, e.g. a forkserver's preload
+            # (or being imported, e.g. by the compiled engine's loader: waiting for that
+            # import here would stall a solve, so the background thread does)
             self.thread = threading.Thread(target=self.load, name="ompl_balance-load-scans")
             self.thread.start()
         return self.scans

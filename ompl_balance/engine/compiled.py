@@ -10,10 +10,16 @@ plans on the compiled engine never loads it.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import math
-from collections.abc import Callable
+import pickle
+import subprocess
+import sys
+import tempfile
+from collections.abc import Callable, Iterator
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 from ompl import base as ob
@@ -43,6 +49,19 @@ def room_per_iteration(layout: SpaceLayout, extent: float, step: float, intermed
 
 
 def _warm(view: Any, layout: SpaceLayout) -> None:
+    """Make the engine for ``view`` and ``layout`` ready in this process: compiled into numba's
+    cache by another process (:mod:`ompl_balance.engine.compile_worker`; a compilation takes tens
+    of seconds, mostly in Python, and would hold this interpreter), then loaded from it here."""
+    try:
+        with _compile_lock():  # one compilation at a time on the machine: the next one finds it cached
+            subprocess.run(
+                [sys.executable, "-m", "ompl_balance.engine.compile_worker"],
+                input=pickle.dumps((view, layout)),
+                capture_output=True,
+                check=True,
+            )
+    except (OSError, subprocess.SubprocessError, pickle.PicklingError):
+        pass  # compiled here instead
     for module in kernel_modules(view):
         importlib.import_module(module)
     from .driver import warm_up
@@ -63,6 +82,22 @@ def load(si: ob.SpaceInformation, layout: SpaceLayout, wait: bool) -> None:
         LOADER.wait(key, warm, _describe(checks))
     else:
         LOADER.start(key, warm)
+
+
+@contextlib.contextmanager
+def _compile_lock() -> Iterator[None]:
+    """An exclusive lock shared by the processes of the machine (where the system has ``flock``)."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    with open(Path(tempfile.gettempdir()) / "ompl_balance-compile.lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def prepared(solve: Solve, layout: SpaceLayout, room: int, wait: bool, name: str) -> CompiledRun | None:

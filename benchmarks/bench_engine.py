@@ -1,0 +1,300 @@
+"""The compiled engine against the Python engine and stock OMPL, measured in one run.
+
+Three parts (``--part``), each printing a table of medians and ratios measured in the same
+run, planners interleaved run by run so that the machine's slow phases hit all of them:
+
+``panda``
+    MotionBenchMaker Panda problems (the four shipped scenarios, the first ``--problems`` of
+    each, VAMP's Panda, certified motions, all of a problem's goals): stock ``og.RRTConnect``,
+    ``BalancedRRTConnect`` on the Python engine and on the compiled engine, all with the
+    package's checker and certified motion validator. Per scenario and planner: success,
+    median time, median iterations, validity checks and motions, time per iteration and per
+    motion (microseconds), calls out of compiled code, which path the checks took, and the
+    ratios compiled / Python and compiled / stock. Every path the compiled engine returns is
+    re-checked every ``--step`` rad per joint by a fresh checker without pre-filter.
+``2d``
+    The built-in 2-D problems with the package's box worlds (the compiled engine calls their
+    kernel), and the bug trap with the same world as a plain Python callable (the compiled
+    engine calls ``si.isValid``/``si.checkMotion``): stock ``og.RRTConnect`` against
+    ``BalancedRRTConnect`` on both engines.
+``profile``
+    Where a compiled solve's time goes on the Panda problems: the certified edges and state
+    checks in compiled code (the edges and states of the same runs, replayed through the
+    kernels), the calls out to Python (FCL on pairs the kernels cannot decide, timed), and the
+    rest (the loop: nearest nodes, sampling, trees; slices and their Python).
+
+Run: ``python benchmarks/bench_engine.py [--part panda,2d,profile] [--problems 25] [--runs 1]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import itertools
+import platform
+import time
+from collections.abc import Callable, Iterator
+from importlib import metadata
+
+import numpy as np
+from cells import medians, ratios, success
+from ompl import geometric as og
+from ompl import util as ou
+
+from ompl_balance import BalancedRRTConnect
+from ompl_balance.collision import certified
+from ompl_balance.collision.checker import CollisionChecker
+from ompl_balance.collision.robots import load_panda_vamp
+from ompl_balance.core.counting import measured_solve
+from ompl_balance.worlds.boxes import BoxWorld2D, get_problem
+from ompl_balance.worlds.mbm import SCENARIOS, MBMProblem, load_mbm
+
+ENGINES = ("python", "compiled")
+KEYS = ("time", "iterations", "checks", "motions", "exits")
+
+
+def stock(si):
+    return og.RRTConnect(si)
+
+
+def balanced(engine: str) -> Callable:
+    def make(si):
+        planner = BalancedRRTConnect(si)
+        planner.setEngine(engine)
+        return planner
+
+    return make
+
+
+PLANNERS = {"RRTConnect": stock, **{f"BalancedRRTConnect[{engine}]": balanced(engine) for engine in ENGINES}}
+
+
+def measure(ss, make_planner, time_limit: float) -> dict:
+    """One solve of ``ss`` (set up outside the timing) and its work."""
+    planner = make_planner(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    run = measured_solve(ss, time_limit)
+    stats = getattr(planner, "stats", None)
+    return {
+        "solved": run.solved,
+        "time": run.time,
+        "checks": run.work.states_checked,
+        "motions": run.work.motions_checked,
+        "iterations": stats.iterations if stats is not None else 0,
+        "exits": stats.exits if stats is not None else 0,
+        "path": stats.checks if stats is not None else "python",
+    }
+
+
+def dense_collisions(reference: CollisionChecker, states: np.ndarray, step: float) -> int:
+    """Segments of the path ``states`` (n, dof) with a colliding state at most ``step`` rad apart."""
+    colliding = 0
+    for a, b in itertools.pairwise(states):
+        count = max(1, int(np.ceil(np.abs(b - a).max() / step)))
+        t = np.arange(count + 1) / count
+        colliding += not reference.check(a + t[:, None] * (b - a)).all()
+    return colliding
+
+
+def table(rows: dict[str, list[dict]], label: str, baseline: str = "RRTConnect") -> None:
+    cell = medians(rows, KEYS)
+    python, stock_cell = cell.get("BalancedRRTConnect[python]"), cell[baseline]
+    for name, runs in rows.items():
+        m = cell[name]
+        to_stock = ratios(m, stock_cell)
+        to_python = ratios(m, python) if python is not None else {"time": float("nan")}
+        per_iteration = m["time"] / m["iterations"] * 1e6 if m["iterations"] else float("nan")
+        print(
+            f"| {label} | {name} | {success(runs):.0%} | {m['time'] * 1e3:.1f} | {m['iterations']:.0f} "
+            f"| {m['checks']:.0f} | {m['motions']:.0f} | {per_iteration:.0f} | {m['time'] / max(m['motions'], 1) * 1e6:.0f} "
+            f"| {m['exits']:.0f} | {runs[0]['path']} | {to_python['time']:.2f} | {to_stock['time']:.2f} "
+            f"| {to_stock['checks']:.2f} |",
+            flush=True,
+        )
+
+
+HEADER = (
+    "| problem | planner | success | median time (ms) | median iterations | median checks | median motions "
+    "| us / iteration | us / motion | exits to Python | checks by | time / Python engine | time / stock "
+    "| checks / stock |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+)
+
+
+def panda(args) -> None:
+    robot = load_panda_vamp()
+    print(
+        f"Panda (VAMP model), first {args.problems} problems per scenario, {args.runs} run(s) each, certified motions\n"
+    )
+    print(HEADER)
+    colliding = solved = 0
+    for scenario in SCENARIOS:
+        rows: dict[str, list[dict]] = {name: [] for name in PLANNERS}
+        for problem in load_mbm(scenario, robot.joint_names)[: args.problems]:
+            for _ in range(args.runs):
+                for name, make in PLANNERS.items():
+                    ss = problem.simple_setup(robot, CollisionChecker(robot, problem.environment))
+                    rows[name].append(measure(ss, make, args.time_limit))
+                    if name == "BalancedRRTConnect[compiled]" and rows[name][-1]["solved"]:
+                        path = ss.getSolutionPath()
+                        states = np.array([path.getState(i)[0 : robot.dof] for i in range(path.getStateCount())])
+                        reference = CollisionChecker(robot, problem.environment, prefilter=False)
+                        colliding += dense_collisions(reference, states, args.step) > 0
+                        solved += 1
+        table(rows, scenario)
+    print(f"\ncompiled engine's returned paths colliding under the {args.step:g} rad re-check: {colliding} of {solved}")
+
+
+def bug_trap_callable_setup():
+    """The bug trap with its world as a plain Python callable: no kernel, OMPL's validator."""
+    problem = get_problem("bug_trap")
+    ss = problem.setup()
+    world = BoxWorld2D(problem.boxes)
+    ss.setStateValidityChecker(lambda state: world.is_free(state[0], state[1]))
+    return ss
+
+
+def two_d(args) -> None:
+    print(f"\n2-D problems, {args.runs_2d} runs each\n")
+    print(HEADER)
+    cases = {name: get_problem(name).setup for name in ("open", "narrow_gap", "bug_trap", "maze")}
+    cases["bug_trap (Python callable)"] = bug_trap_callable_setup
+    for label, make_setup in cases.items():
+        rows: dict[str, list[dict]] = {name: [] for name in PLANNERS}
+        for _ in range(args.runs_2d):
+            for name, make in PLANNERS.items():
+                rows[name].append(measure(make_setup(), make, args.time_limit))
+        table(rows, label)
+
+
+@contextlib.contextmanager
+def recorded_checks() -> Iterator[tuple[list[tuple[np.ndarray, np.ndarray]], list[np.ndarray]]]:
+    """The certified edges and the states the package's checkers are asked about while inside."""
+    edges: list[tuple[np.ndarray, np.ndarray]] = []
+    states: list[np.ndarray] = []
+    check, is_valid = certified.MotionCertifier.check, CollisionChecker.is_valid
+
+    def record_edge(self, a, b, last_valid=False):
+        edges.append((np.array(a), np.array(b)))
+        return check(self, a, b, last_valid)
+
+    def record_state(self, q):
+        states.append(np.array(q, dtype=float).reshape(-1))
+        return is_valid(self, q)
+
+    certified.MotionCertifier.check, CollisionChecker.is_valid = record_edge, record_state
+    try:
+        yield edges, states
+    finally:
+        certified.MotionCertifier.check, CollisionChecker.is_valid = check, is_valid
+
+
+@contextlib.contextmanager
+def timed_exits() -> Iterator[list[float]]:
+    """Seconds spent in the compiled kernels' calls out to Python (FCL) while inside, in ``[0]``."""
+    spent = [0.0]
+    decide, hard = CollisionChecker.decide, certified.MotionCertifier.hard_segments_free
+
+    def timed(function):
+        def wrapper(*arguments, **keywords):
+            began = time.perf_counter()
+            try:
+                return function(*arguments, **keywords)
+            finally:
+                spent[0] += time.perf_counter() - began
+
+        return wrapper
+
+    CollisionChecker.decide, certified.MotionCertifier.hard_segments_free = timed(decide), timed(hard)
+    try:
+        yield spent
+    finally:
+        CollisionChecker.decide, certified.MotionCertifier.hard_segments_free = decide, hard
+
+
+def seeded_solve(robot, problem: MBMProblem, engine: str, seed: int, time_limit: float) -> float:
+    ss = problem.simple_setup(robot, CollisionChecker(robot, problem.environment))
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine(engine)
+    planner.setSeed(seed)
+    ss.setPlanner(planner)
+    return measured_solve(ss, time_limit).time
+
+
+def profile_problem(robot, problem: MBMProblem, time_limit: float, replay: Callable) -> tuple[float, float, float, int]:
+    """A compiled solve's time, its time in calls out to Python, its edges' and states' time in the
+    kernels, and its edges. The Python engine on the same seed makes the same trees, so its
+    validator's calls are the compiled engine's edges and states."""
+    seed = 1 + problem.id
+    with recorded_checks() as (edges, states):
+        seeded_solve(robot, problem, "python", seed, time_limit)
+    with timed_exits() as spent:
+        solve_time = seeded_solve(robot, problem, "compiled", seed, time_limit)
+    exit_time = spent[0]
+    if not edges:
+        return solve_time, exit_time, 0.0, 0
+    view = certified.MotionCertifier(CollisionChecker(robot, problem.environment)).compiled_view()
+    starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
+    with timed_exits() as spent:
+        began = time.perf_counter()
+        replay(view, starts, ends, np.array(states).reshape(-1, robot.dof))
+        kernel_time = time.perf_counter() - began - spent[0]
+    return solve_time, exit_time, kernel_time, len(edges)
+
+
+def profile(args) -> None:
+    """Where the compiled engine's time goes (see the module docstring)."""
+    from numba import njit
+
+    from ompl_balance.collision.kernels import certified_motion_free, robot_state_free
+
+    @njit
+    def replay(view, starts, ends, states):  # the edges and states of a run, through the kernels
+        free = 0
+        for i in range(starts.shape[0]):
+            free += certified_motion_free(view, starts[i], ends[i])
+        for i in range(states.shape[0]):
+            free += robot_state_free(view.states, states[i])
+        return free
+
+    robot = load_panda_vamp()
+    print(f"\nWhere a compiled solve's time goes: first {args.problems} problems per scenario, certified motions\n")
+    print(
+        "| scenario | solve time (ms, total) | edges and states in compiled code | calls out to Python (FCL) "
+        "| the loop and its slices | us / edge (kernel) |\n|---|---|---|---|---|---|"
+    )
+    for scenario in SCENARIOS:
+        totals = np.zeros(4)
+        for problem in load_mbm(scenario, robot.joint_names)[: args.problems]:
+            totals += profile_problem(robot, problem, args.time_limit, replay)
+        solve_time, exit_time, kernel_time, edges = totals
+        rest = solve_time - exit_time - kernel_time
+        print(
+            f"| {scenario} | {solve_time * 1e3:.0f} | {kernel_time / solve_time:.0%} | {exit_time / solve_time:.0%} "
+            f"| {rest / solve_time:.0%} | {kernel_time / max(edges, 1) * 1e6:.0f} |",
+            flush=True,
+        )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--part", default="panda,2d,profile", help="comma-separated parts: panda, 2d, profile")
+    parser.add_argument("--problems", type=int, default=25, help="Panda problems per scenario (default 25)")
+    parser.add_argument("--runs", type=int, default=1, help="Panda runs per problem and planner (default 1)")
+    parser.add_argument("--runs-2d", type=int, default=30, help="2-D runs per problem and planner (default 30)")
+    parser.add_argument("--time-limit", type=float, default=10.0, help="seconds per run (default 10)")
+    parser.add_argument("--step", type=float, default=0.005, help="Panda re-check resolution, rad (default 0.005)")
+    args = parser.parse_args()
+    ou.RNG.setSeed(1)
+    ou.setLogLevel(ou.LOG_ERROR)
+    began = time.perf_counter()
+    print(
+        f"{time.strftime('%Y-%m-%d')}, {platform.machine()} {platform.processor() or ''}, Python "
+        f"{platform.python_version()}, ompl {metadata.version('ompl')}; compiled engine loaded before timing\n"
+    )
+    for part in args.part.split(","):
+        {"panda": panda, "2d": two_d, "profile": profile}[part](args)
+    print(f"\nwhole script: {time.perf_counter() - began:.0f} s; median of runs, ratios of medians")
+
+
+if __name__ == "__main__":
+    main()
