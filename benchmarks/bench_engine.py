@@ -232,7 +232,8 @@ def profile_problem(robot, problem: MBMProblem, time_limit: float, replay: Calla
     exit_time = spent[0]
     if not edges:
         return solve_time, exit_time, 0.0, 0
-    view = certified.MotionCertifier(CollisionChecker(robot, problem.environment)).compiled_view()
+    certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))  # (the view's exits)
+    view = certifier.compiled_view()
     starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
     with timed_exits() as spent:
         began = time.perf_counter()
