@@ -20,8 +20,10 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from ompl_balance.bench.compare import bench
-from ompl_balance.bench.experiment import Experiment, ExperimentError, PlannerSpec, ProblemSpec
+from ompl_balance.bench.errors import ExperimentError
+from ompl_balance.bench.experiment import Experiment, PlannerSpec
 from ompl_balance.bench.planner_params import DECLARED_PARAMS, planner_params, set_planner_param
+from ompl_balance.bench.problems import ProblemSpec
 
 ARENA_TIME_LIMIT = 0.3  # s: RRT* planners run to it, so they are sampled about 6 times
 

@@ -16,7 +16,8 @@ from ompl import base as ob
 from test_benchmark import deterministic
 
 from ompl_balance.bench.compare import bench
-from ompl_balance.bench.experiment import Experiment, PlannerSpec, ProblemSpec
+from ompl_balance.bench.experiment import Experiment, PlannerSpec
+from ompl_balance.bench.problems import ProblemSpec
 
 REPO = Path(__file__).resolve().parents[1]
 TESTS = Path(__file__).resolve().parent

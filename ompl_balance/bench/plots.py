@@ -33,9 +33,10 @@ from ompl import base as ob
 from ..core.planner import GOAL_TAG, START_TAG
 from ..planners import BalancedRRTConnect
 from ..worlds.boxes import PROBLEMS
-from .experiment import Experiment, ExperimentError, MissingExtraError
+from .errors import ExperimentError, MissingExtraError
+from .experiment import Experiment
+from .results import Record, ResultStore
 from .resume import experiment_records
-from .runner import Record, ResultStore
 from .summary import format_csv, format_markdown, pooled_by_scenario, summarize
 
 MATPLOTLIB_MISSING = "plots need matplotlib: pip install 'ompl-balance[plot]'"
