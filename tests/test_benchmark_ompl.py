@@ -297,6 +297,34 @@ def test_plot_draws_median_best_cost_against_time(arena):
     assert {"progress_narrow_gap.png", "success_vs_time.png", "narrow_gap.png", "trees_narrow_gap.png"} <= written
 
 
+def test_records_say_which_planners_keep_improving_their_solution(arena):
+    _out, records = arena
+    improving = {r["planner"]: r["improves_cost"] for r in records}
+    assert improving == {
+        "RRTConnect": False,
+        "RRTstar": True,  # stock: its best cost is sampled through the bound methods
+        "BallRadiusRRTstar": True,
+        "BalancedRRTConnect": False,  # reports a best cost, but stops at its first solution
+        "AORRTC": True,
+        "raising": False,
+    }
+
+
+def test_progress_is_drawn_for_improving_planners_only(arena, tmp_path):
+    pytest.importorskip("matplotlib")
+    import json
+
+    from ompl_balance.bench.plots import plot_progress
+
+    out, records = arena
+    experiment = Experiment.from_dict(json.loads((out / "experiment.json").read_text()))
+    first_solution_only = [r for r in records if r["planner"] in ("RRTConnect", "BalancedRRTConnect")]
+    assert any("progress" in r for r in first_solution_only)
+    assert plot_progress(first_solution_only, experiment, "narrow_gap", tmp_path / "none.png") is None
+    stock_rrtstar = [r for r in records if r["planner"] == "RRTstar"]
+    assert plot_progress(stock_rrtstar, experiment, "narrow_gap", tmp_path / "rrtstar.png") is not None
+
+
 def test_median_best_cost_holds_each_runs_last_value():
     from ompl_balance.bench.plots import median_best_cost
 

@@ -152,8 +152,8 @@ def _not_returned(task: RunTask, phase: str | None, phase_began: float, killed: 
     """What happened to a run killed at its hard limit, in words, from the phase it was in."""
     planner = task.planner.name or task.planner.label
     kill = (
-        f"the process was killed at the hard limit of {task.hard_limit:g} s (2 x the time limit + the margin), "
-        f"{killed - phase_began:.1f} s after that phase began"
+        f"the process was killed {killed - phase_began:.1f} s after it began, at the run's hard limit of "
+        f"{task.hard_limit:g} s (2 x the time limit + the margin)"
     )
     if phase is None:
         return f"the run did not get to planning ({_PHASE_WORDS[None]}); {kill}"
