@@ -93,6 +93,7 @@ _LAZY = {
     "run_isolated": "bench.isolation",
     "ResultStore": "bench.results",
     "sweep": "bench.scheduling",
+    "run_ompl_benchmark": "bench.ompl_benchmark",
     "write_logs": "bench.logs",
     "to_database": "bench.logs",
     "summarize": "bench.summary",

@@ -26,39 +26,12 @@ from ompl import util as ou
 from ..core.counting import read_work
 from .experiment import RunTask
 from .planner_params import named_by_getters, planner_params
+from .planner_properties import graph_properties, stats_properties, typed
 from .progress_sampler import ProgressSampler, improves_cost, progress_properties
 from .results import STATUS_INDEX, Record, failure_properties, run_record, status_name
 
-#: Stock planners whose ``PlannerData`` tags the start tree's vertices 1 and the goal
-#: tree's 2 (``RRTConnect::getPlannerData``); this package's planners report their tree
-#: sizes in ``stats``.
-TREE_TAGGING_STOCK_PLANNERS = (og.RRTConnect,)
-
 #: The phases of a run, in order, as :func:`execute` reports them.
 PHASES = ("warm-up", "solve", "simplification")
-
-
-def _typed(name: str, value: Any) -> tuple[str, Any]:
-    """An OMPL log property ``"name TYPE"`` for a Python value (bool -> BOOLEAN 0/1)."""
-    if isinstance(value, bool):
-        return f"{name} BOOLEAN", int(value)
-    if isinstance(value, int):
-        return f"{name} INTEGER", value
-    return f"{name} REAL", float(value)
-
-
-def _graph_properties(ss: og.SimpleSetup, planner: ob.Planner) -> dict[str, Any]:
-    """Graph states and motions of every planner; start and goal tree sizes of stock RRT-Connect."""
-    if hasattr(planner, "plannerData"):  # this package's planners (see TreePlanner.plannerData)
-        data = planner.plannerData()
-    else:
-        data = ob.PlannerData(ss.getSpaceInformation())
-        planner.getPlannerData(data)
-    properties = dict([_typed("graph states", data.numVertices()), _typed("graph motions", data.numEdges())])
-    if isinstance(planner, TREE_TAGGING_STOCK_PLANNERS):
-        tags = [data.getVertex(i).getTag() for i in range(data.numVertices())]
-        properties.update([_typed("start tree size", tags.count(1)), _typed("goal tree size", tags.count(2))])
-    return properties
 
 
 def _peak_memory() -> float:
@@ -231,9 +204,9 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
         path = ss.getSolutionPath()  # keep the owner while reading it
         properties.update(
             [
-                _typed("approximate solution", not ss.haveExactSolutionPath()),
-                _typed("solution length", path.length()),
-                _typed("solution segments", path.getStateCount() - 1),
+                typed("approximate solution", not ss.haveExactSolutionPath()),
+                typed("solution length", path.length()),
+                typed("solution segments", path.getStateCount() - 1),
             ]
         )
         phase("simplification")
@@ -243,16 +216,12 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
         simplified = ss.getSolutionPath()
         properties.update(
             [
-                _typed("simplified solution length", simplified.length()),
-                _typed("simplified solution segments", simplified.getStateCount() - 1),
+                typed("simplified solution length", simplified.length()),
+                typed("simplified solution segments", simplified.getStateCount() - 1),
             ]
         )
-    properties.update(_graph_properties(ss, planner))
-    stats = getattr(planner, "stats", None)
-    if stats is not None:
-        for name, value in stats.as_dict().items():
-            if name not in _MEASURED_HERE and isinstance(value, (int, float)):
-                properties.update([_typed(name.replace("_", " "), value)])
+    properties.update(graph_properties(planner))
+    properties.update(stats_properties(planner, _MEASURED_HERE))
     properties["memory REAL"] = _peak_memory() - memory.start  # MB the run added (OMPL: after minus before)
     record = run_record(task, status_text, properties, params, "", improving)
     if memory.reached:
