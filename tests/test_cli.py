@@ -213,3 +213,15 @@ def test_plot_refuses_a_baseline_that_is_not_a_planner(capsys, tmp_path):
     assert main(["compare", "--runs", "1", "--problems", "open", "-o", str(out), "--no-progress"]) == 0
     capsys.readouterr()
     _one_line_error(capsys, ["plot", str(out), "--baseline", "Nope"], "baseline: 'Nope' is not a planner of")
+
+
+def test_compare_turns_the_warm_up_off_as_an_experiment_file_does(capsys, tmp_path):
+    out = tmp_path / "out"
+    args = ["compare", "--runs", "1", "--problems", "open", "--planners", "PRM", "-o", str(out), "--no-progress"]
+    assert main([*args, "--no-warm-up"]) == 0
+    assert json.loads((out / "experiment.json").read_text())["warm_up"] is False
+    assert main(args) == 0  # warm-up on (the default): another definition of the cell, run again
+    assert json.loads((out / "experiment.json").read_text())["warm_up"] is True
+    assert "warm_up False -> True" in capsys.readouterr().err
+    records = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
+    assert [r["status"] for r in records] == ["EXACT_SOLUTION"]  # PRM solves with its warm-up too

@@ -98,7 +98,7 @@ class MemoryLimit:
 KEEP_UNTIL_EXIT: list[og.SimpleSetup] = []
 
 #: Longest warm-up solve (s; at most the run's time limit); it ends sooner at its first exact solution.
-WARM_UP_TIME = 0.05
+WARM_UP_TIME = 0.02
 
 
 def warm_up(task: RunTask) -> None:

@@ -12,7 +12,7 @@ process that died or had to be killed, saying in which phase of the run
 (:data:`~ompl_balance.bench.execution.PHASES`). A planner that did not return from its solve
 is then solved once more in a plain ``ss.solve(time_limit)`` in a process of its own (no
 warm-up, no progress or memory thread), and the record says whether that returned: whether
-the planner hangs by itself or under the benchmark.
+the planner hangs (or dies) by itself or only under the benchmark.
 """
 
 from __future__ import annotations
@@ -109,15 +109,16 @@ def _plain_child(task: RunTask, connection: Any) -> None:
     connection.send(time.perf_counter() - began)
 
 
-#: Seconds a plain solve of a cell took (``None``: it did not return), by cell definition.
-_PLAIN_SOLVES: dict[str, float | None] = {}
+#: What a plain solve of a cell did, by cell definition (see plain_solve).
+_PLAIN_SOLVES: dict[str, str] = {}
 _PLAIN_LOCK = threading.Lock()
 
 
-def plain_solve_seconds(task: RunTask) -> float | None:
-    """Seconds a plain ``ss.solve(task.time_limit)`` of ``task``'s problem and planner takes in a
-    fresh process (no warm-up, no progress or memory thread), ``None`` when it has not returned
-    after ``task.hard_limit`` seconds. Measured once per cell and sweep process."""
+def plain_solve(task: RunTask) -> str:
+    """What a plain ``ss.solve(task.time_limit)`` of ``task``'s problem and planner does in a fresh
+    process (no warm-up, no progress or memory thread), waited for ``task.hard_limit`` seconds:
+    ``"returns in 0.51 s"``, ``"does not return"`` or ``"ends its process (... killed by SIGSEGV)"``.
+    Found once per cell and sweep process."""
     with _PLAIN_LOCK:
         if task.definition in _PLAIN_SOLVES:
             return _PLAIN_SOLVES[task.definition]
@@ -127,17 +128,18 @@ def plain_solve_seconds(task: RunTask) -> float | None:
     process.start()
     sender.close()
     try:
-        seconds = receiver.recv() if receiver.poll(task.hard_limit) else None
-    except EOFError:  # it died: it returned no time
-        seconds = None
+        outcome = f"returns in {receiver.recv():.2f} s" if receiver.poll(task.hard_limit) else "does not return"
+    except EOFError:  # the process died before it could report
+        process.join(1.0)
+        outcome = f"ends its process ({_exit_text(process.exitcode)})"
     finally:
         receiver.close()
         if process.is_alive():
             process.kill()
         process.join()
     with _PLAIN_LOCK:
-        _PLAIN_SOLVES[task.definition] = seconds
-    return seconds
+        _PLAIN_SOLVES[task.definition] = outcome
+    return outcome
 
 
 _PHASE_WORDS = {
@@ -160,18 +162,21 @@ def _not_returned(task: RunTask, phase: str | None, phase_began: float, killed: 
     if phase == "simplification":
         return f"path simplification, bounded by the time limit of {task.time_limit:g} s, did not return; {kill}"
     if phase == "warm-up":
-        ended = f"the untimed warm-up solve, which its termination condition ended after at most {min(WARM_UP_TIME, task.time_limit):g} s"
+        ended = (
+            "the untimed warm-up solve, which its termination condition ended after at most "
+            f"{min(WARM_UP_TIME, task.time_limit):g} s"
+        )
     else:
         ended = f"the timed solve, which its termination condition ended at the time limit of {task.time_limit:g} s"
-    plain = plain_solve_seconds(task)
     check = f"a plain ss.solve({task.time_limit:g}) in a fresh process (no warm-up, no progress or memory thread)"
-    if plain is None:
-        verdict = f"{check} does not return either: the planner hangs by itself, not under the benchmark"
-    else:
+    plain = plain_solve(task)
+    if plain.startswith("returns"):
         verdict = (
-            f"{check} returns in {plain:.2f} s, so the benchmark kept it from returning: please report this as a "
-            "bug of ompl-balance"
+            f"{check} {plain}, so the benchmark kept it from returning: please report this as a bug of ompl-balance"
         )
+    else:
+        how = "hangs" if plain == "does not return" else "fails"
+        verdict = f"{check} {plain} either: the planner {how} by itself, not under the benchmark"
     return f"{planner} did not return from {ended}; {kill}; {verdict}"
 
 
