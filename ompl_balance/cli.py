@@ -10,15 +10,18 @@
     runs an experiment file (docs/benchmark.md) into ``OUT/``: results, OMPL logs, the
     SQLite database and the summary; running it again resumes.
 ``ompl-balance plot OUT/``
-    box plots, success-vs-time curves, median best cost against time (RRT*), the summary
-    table and, for 2-D problems, the two trees of balanced and alternating growth (needs
-    matplotlib: the ``plot`` extra).
+    per problem how each planner's runs ended and the times to a solution and validity
+    checks of its solved runs, success-vs-time curves, the median best cost against time
+    of planners that keep improving it (RRT*), the summary table and, for 2-D problems, the
+    two trees of balanced and alternating growth (needs matplotlib: the ``plot`` extra).
 ``ompl-balance gamma``
     RRT*'s ball-radius constant for a built-in problem or an occupancy grid, and the
     ``rewire_factor`` that gives OMPL's ``RRTstar`` the same radius schedule.
 
-Every run executes in its own process; ``--jobs N`` runs N at a time, ``--dask
-tcp://HOST:PORT`` or ``--dask local:N`` on a Dask cluster (the ``distributed`` extra).
+Every run executes in its own process, after an untimed short solve that warms the
+planner's code up (``--no-warm-up`` to time the cold first solve); ``--jobs N`` runs N at a
+time, ``--dask tcp://HOST:PORT`` or ``--dask local:N`` on a Dask cluster (the
+``distributed`` extra).
 """
 
 from __future__ import annotations
