@@ -31,7 +31,7 @@ from .logs import to_database, write_logs
 from .problems import problem_by_name
 from .results import Record, ResultStore
 from .resume import RESULTS_FILE, SUPERSEDED, claim, experiment_records, supersede_files
-from .scheduling import SweepCounts, prepare_local_runs, sweep
+from .scheduling import SweepCounts, missing_tasks, prepare_local_runs, sweep
 from .summary import format_csv, format_markdown, summarize
 
 STOCK_LABEL = "RRTConnect"
@@ -148,7 +148,7 @@ def bench(
     if claimed.superseded:
         notify(claimed.message(out))
     store = ResultStore(out / RESULTS_FILE)
-    if dask is None:
+    if dask is None and missing_tasks(experiment, store):
         prepare_local_runs(experiment)
     bar = tqdm(
         total=len(experiment.tasks()),
