@@ -24,7 +24,10 @@ import argparse
 import statistics
 from pathlib import Path
 
-import matplotlib
+try:
+    import matplotlib
+except ImportError:  # the plot extra
+    raise SystemExit("ball_radius_constant.py draws with matplotlib: pip install 'ompl-balance[plot]'") from None
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -116,6 +119,9 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=3, help="seeds per gamma for figures 5 and 6 (default 3)")
     parser.add_argument("--iterations", type=int, default=600, help="iterations per run (default 600)")
     args = parser.parse_args()
+    for option in ("seeds", "iterations"):
+        if getattr(args, option) < 1:
+            parser.error(f"--{option} must be a whole number >= 1, got {getattr(args, option)}")
     ou.setLogLevel(ou.LOG_WARN)
     args.output.mkdir(parents=True, exist_ok=True)
 
@@ -127,13 +133,12 @@ def main() -> None:
     exact = ball_radius_constant(2, problem.grid.free_area)
     print(f"rooms map: estimated gamma {estimated:.0f} m^2 (exact gamma* {exact:.0f} m^2)")
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5.5))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5.8), layout="constrained")
     for ax, gamma, title in (
         (axes[0], 100.0, "gamma = 100"),
         (axes[1], estimated, f"estimated gamma = {estimated:.0f}"),
     ):
         draw_tree(ax, problem, *plan(problem, gamma, seed=1, iterations=args.iterations), title)
-    fig.tight_layout()
     fig.savefig(args.output / "tree_gamma_100_vs_estimated.png", dpi=120)
     plt.close(fig)
 
@@ -147,19 +152,27 @@ def main() -> None:
             f"gamma {gamma:8.0f}: median final cost {np.median(costs[gamma][:, -1]):.2f} m, median time {times[gamma]:.2f} s"
         )
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = plt.subplots(figsize=(8.5, 4.5), layout="constrained")
     steps = np.arange(1, args.iterations + 1)
+    # gammas whose runs are identical (their radius stays at eta over these iterations) share one curve
+    same_runs: dict[bytes, list[float]] = {}
     for gamma in gammas:
-        low, mid, high = np.percentile(costs[gamma], [25, 50, 75], axis=0, method="nearest")  # inf until a path
-        line = ax.plot(steps, mid, label=f"gamma = {gamma:.0f}")[0]
+        same_runs.setdefault(costs[gamma].tobytes(), []).append(gamma)
+    for group, style in zip(same_runs.values(), ("-", "--", "-.", ":", (0, (5, 1)))):
+        with np.errstate(invalid="ignore"):  # inf - inf between runs without a path yet: not drawn
+            low, high = np.percentile(costs[group[0]], [25, 75], axis=0)
+        mid = np.median(costs[group[0]], axis=0)  # as printed above; no line until half the runs have a path
+        low, high, mid = (np.where(np.isfinite(values), values, np.nan) for values in (low, high, mid))
+        names = ", ".join(f"{gamma:.0f}" for gamma in group)
+        label = f"gamma = {names}" + (" (identical runs)" if len(group) > 1 else "")
+        line = ax.plot(steps, mid, linestyle=style, label=label)[0]
         ax.fill_between(steps, low, high, color=line.get_color(), alpha=0.2)
     ax.set(
         xlabel="iterations",
         ylabel="best path cost (m)",
         title=f"Rooms map, {args.seeds} seeds: median and interquartile range",
     )
-    ax.legend()
-    fig.tight_layout()
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     fig.savefig(args.output / "cost_vs_iterations.png", dpi=120)
     plt.close(fig)
 

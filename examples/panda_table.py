@@ -4,9 +4,11 @@ Uses example-robot-data's Panda (``pip install 'ompl-balance[robots]'``): 8 join
 eighth being the finger opening, held at 0.02 m here. ``setup_robot`` installs the
 certified motion validator: every edge of the returned path is proved collision-free
 (``certify_path`` re-checks it). Prints time, path length and the collision-checking work
-of each planner. Run: ``python examples/panda_table.py``.
+of each planner. Run: ``python examples/panda_table.py [--time-limit 10]``.
 """
 
+import argparse
+import sys
 import time
 
 import numpy as np
@@ -23,34 +25,48 @@ from ompl_balance import (
     space_for,
 )
 
-robot = load_example_robot_data_panda()
-environment = Environment()
-environment.add_box("table", half_extents=[0.6, 0.8, 0.02], position=[0.5, 0.0, -0.04])  # top 2 cm below the base
-environment.add_box("box", half_extents=[0.05, 0.2, 0.25], position=[0.5, 0.0, 0.25])
-checker = CollisionChecker(robot, environment)
 
-start = np.array([-0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # hand in front, left of the box
-goal = np.array([0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # mirrored, right of the box
-assert checker.check([start, goal]).all(), "start and goal must be collision-free"
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--time-limit", type=float, default=10.0, help="seconds of planning per planner (default 10)")
+    args = parser.parse_args()
+    if not args.time_limit > 0:
+        parser.error(f"--time-limit must be a positive number of seconds, got {args.time_limit}")
+    try:
+        robot = load_example_robot_data_panda()
+    except ImportError as error:  # the robots extra is not installed
+        sys.exit(f"panda_table.py: {error}")
+    environment = Environment()
+    environment.add_box("table", half_extents=[0.6, 0.8, 0.02], position=[0.5, 0.0, -0.04])  # top 2 cm below the base
+    environment.add_box("box", half_extents=[0.05, 0.2, 0.25], position=[0.5, 0.0, 0.25])
+    checker = CollisionChecker(robot, environment)
 
-for name, make_planner in [("RRTConnect", og.RRTConnect), ("BalancedRRTConnect", BalancedRRTConnect)]:
-    ss = og.SimpleSetup(space_for(robot))
-    setup_robot(ss, checker)
-    si = ss.getSpaceInformation()
-    s, g = si.allocState(), si.allocState()
-    for i in range(robot.dof):
-        s[i], g[i] = float(start[i]), float(goal[i])
-    ss.setStartAndGoalStates(s, g)
-    ss.setPlanner(make_planner(si))
-    before = read_work(si)
-    began = time.perf_counter()
-    solved = ss.solve(10.0)
-    elapsed = time.perf_counter() - began
-    work = read_work(si) - before
-    length = ss.getSolutionPath().length() if solved else float("nan")
-    certified = certify_path(checker, ss.getSolutionPath()).certified if solved else False
-    print(
-        f"{name:20s} {solved.asString() if hasattr(solved, 'asString') else solved!s:16s} {elapsed:6.2f} s  "
-        f"path length {length:.2f} rad  certified {certified}  states checked {work.states_checked}  "
-        f"motions checked {work.motions_checked}  distance queries {work.distance_queries}"
-    )
+    start = np.array([-0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # hand in front, left of the box
+    goal = np.array([0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # mirrored, right of the box
+    assert checker.check([start, goal]).all(), "start and goal must be collision-free"
+
+    for name, make_planner in [("RRTConnect", og.RRTConnect), ("BalancedRRTConnect", BalancedRRTConnect)]:
+        ss = og.SimpleSetup(space_for(robot))
+        setup_robot(ss, checker)
+        si = ss.getSpaceInformation()
+        s, g = si.allocState(), si.allocState()
+        for i in range(robot.dof):
+            s[i], g[i] = float(start[i]), float(goal[i])
+        ss.setStartAndGoalStates(s, g)
+        ss.setPlanner(make_planner(si))
+        before = read_work(si)
+        began = time.perf_counter()
+        solved = ss.solve(args.time_limit)
+        elapsed = time.perf_counter() - began
+        work = read_work(si) - before
+        length = ss.getSolutionPath().length() if solved else float("nan")
+        certified = certify_path(checker, ss.getSolutionPath()).certified if solved else False
+        print(
+            f"{name:20s} {solved.asString() if hasattr(solved, 'asString') else solved!s:16s} {elapsed:6.2f} s  "
+            f"path length {length:.2f} rad  certified {certified}  states checked {work.states_checked}  "
+            f"motions checked {work.motions_checked}  distance queries {work.distance_queries}"
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -10,38 +10,38 @@
     runs an experiment file (docs/benchmark.md) into ``OUT/``: results, OMPL logs, the
     SQLite database and the summary; running it again resumes.
 ``ompl-balance plot OUT/``
-    box plots, success-vs-time curves, median best cost against time (RRT*), the summary
-    table and, for 2-D problems, the two trees of balanced and alternating growth (needs
-    matplotlib: the ``plot`` extra).
+    per problem how each planner's runs ended and the times to a solution and validity
+    checks of its solved runs, success-vs-time curves, the median best cost against time
+    of planners that keep improving it (RRT*), the summary table and, for 2-D problems, the
+    two trees of balanced and alternating growth (needs matplotlib: the ``plot`` extra).
 ``ompl-balance gamma``
     RRT*'s ball-radius constant for a built-in problem or an occupancy grid, and the
     ``rewire_factor`` that gives OMPL's ``RRTstar`` the same radius schedule.
 
-Every run executes in its own process; ``--jobs N`` runs N at a time, ``--dask
-tcp://HOST:PORT`` or ``--dask local:N`` on a Dask cluster (the ``distributed`` extra).
+Every run executes in its own process, after an untimed short solve that warms the
+planner's code up (``--no-warm-up`` to time the cold first solve); ``--jobs N`` runs N at a
+time, ``--dask tcp://HOST:PORT`` or ``--dask local:N`` on a Dask cluster (the
+``distributed`` extra).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 from ompl import util as ou
 
-from .bench.compare import (
-    COMPARE_MBM_PROBLEMS,
-    COMPARE_SEED,
-    bench,
-    compare_experiment,
-    compare_problem,
-    parse_planners,
-)
-from .bench.experiment import Experiment, ExperimentError, MissingExtraError, PlannerSpec, load_experiment
-from .bench.runner import require_dask
+from .bench.compare import COMPARE_MBM_PROBLEMS, COMPARE_SEED, bench, compare_experiment, parse_planners
+from .bench.errors import ExperimentError, MissingExtraError
+from .bench.experiment import Experiment, PlannerSpec
+from .bench.experiment_file import load_experiment
+from .bench.problems import problem_by_name
+from .bench.scheduling import require_dask
 from .gamma import ball_radius_constant, estimate_free_measure, ompl_rewire_factor, rewire_radius
 from .worlds.boxes import PROBLEMS
 from .worlds.occupancy import OCCUPANCY_PROBLEMS, OccupancyGrid, OccupancyProblem
@@ -53,7 +53,7 @@ def _problem_names(text: str) -> list[str]:
         raise argparse.ArgumentTypeError("no problem given")
     for name in names:
         try:
-            compare_problem(name)
+            problem_by_name(name)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error)) from error
     return names
@@ -67,16 +67,47 @@ def _planners(text: str) -> list[PlannerSpec]:
 
 
 def _positive_int(text: str) -> int:
-    value = int(text)
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
     if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text}")
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
     return value
 
 
-def _positive_float(text: str) -> float:
-    value = float(text)
-    if not value > 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, got {text}")
+def _whole_number(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {text!r}")
+    return value
+
+
+def _positive(unit: str) -> Callable[[str], float]:
+    """An argument type: a positive finite number of ``unit``."""
+
+    def positive(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not 0 < value < math.inf:
+            raise argparse.ArgumentTypeError(f"must be a positive number of {unit}, got {text!r}")
+        return value
+
+    return positive
+
+
+def _fraction(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 < value < 1:
+        raise argparse.ArgumentTypeError(f"must be a number between 0 and 1 (exclusive), got {text!r}")
     return value
 
 
@@ -114,7 +145,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     compare.add_argument("--runs", type=_positive_int, default=20, help="runs per planner and problem (default 20)")
     compare.add_argument(
-        "--time-limit", type=_positive_float, default=5.0, help="seconds each run may plan (default 5)"
+        "--time-limit", type=_positive("seconds"), default=5.0, help="seconds each run may plan (default 5)"
     )
     compare.add_argument(
         "--problems",
@@ -130,6 +161,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="comma-separated planners: stock OMPL names (RRTConnect, RRT, PRM, ...), this package's "
         "planners and presets, each optionally NAME[param=value;...] (default: RRTConnect, "
         "BalancedRRTConnect, BalancedRRTConnect[balance_tree_sizes=0])",
+    )
+    compare.add_argument(
+        "--warm-up",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="before each timed solve, an untimed short solve of a copy of the problem, so the first "
+        "execution of the planner's code in the run's process is not what is timed (default: on)",
     )
     compare.add_argument(
         "--seed",
@@ -180,7 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--grid", metavar="FILE.npy", help="a 2-D boolean occupancy array (True = occupied) saved with numpy.save"
     )
     gamma.add_argument(
-        "--resolution", type=_positive_float, default=0.2, help="cell side of --grid in metres (default 0.2)"
+        "--resolution", type=_positive("metres"), default=0.2, help="cell side of --grid in metres (default 0.2)"
     )
     gamma.add_argument(
         "--samples",
@@ -188,13 +226,18 @@ def build_parser() -> argparse.ArgumentParser:
         default=20000,
         help="Monte Carlo samples when the measure is estimated (default 20000)",
     )
-    gamma.add_argument("--confidence", type=float, default=0.95, help="confidence level of the interval (default 0.95)")
+    gamma.add_argument(
+        "--confidence", type=_fraction, default=0.95, help="confidence level of the interval (default 0.95)"
+    )
     gamma.add_argument(
         "--monte-carlo", action="store_true", help="estimate by sampling even when a grid allows exact counting"
     )
-    gamma.add_argument("--seed", type=int, default=None, help="seed of the Monte Carlo samples")
+    gamma.add_argument("--seed", type=_whole_number, default=None, help="seed of the Monte Carlo samples")
     gamma.add_argument(
-        "--eta", type=float, default=0.0, help="maximum connection distance for the radius table (default 0.2 x extent)"
+        "--eta",
+        type=_positive("metres"),
+        default=None,
+        help="maximum connection distance for the radius table, in the space's units (default 0.2 x extent)",
     )
     return parser
 
@@ -260,9 +303,11 @@ def _gamma(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         )
     except ValueError as error:
         parser.error(str(error))
+    if not free.high > 0:
+        parser.error(f"{problem_name}: no state is free (every cell occupied), so there is no ball radius to estimate")
     d = si.getStateDimension()
     gamma = ball_radius_constant(d, free.high)
-    eta = args.eta if args.eta > 0 else 0.2 * si.getMaximumExtent()
+    eta = args.eta if args.eta is not None else 0.2 * si.getMaximumExtent()
     print(f"problem            {problem_name} ({si.getStateSpace().getName()}, d = {d})")
     print(f"space measure      {free.space_measure:.6g}")
     if free.exact:
@@ -292,7 +337,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if getattr(args, "dask", None):
             require_dask()
         if args.command == "compare":
-            experiment = compare_experiment(args.problems, args.planners, args.runs, args.time_limit, args.seed)
+            experiment = compare_experiment(
+                args.problems, args.planners, args.runs, args.time_limit, args.seed, args.warm_up
+            )
             print(f"experiment seed {experiment.seed}")
             if args.out is not None:
                 return _run(experiment, args.out, args)

@@ -285,10 +285,22 @@ class BalancedRRTConnect(TreePlanner):
         self._check_policies()
         self._valid_sampler = None  # allocated again from the current allocator
         if self.settings.engine != "python" and not self._why_not_compiled():
-            si = self.getSpaceInformation()
-            layout = layout_for(si.getStateSpace())
-            assert layout is not None
-            load_engine(si, layout, wait=self.settings.engine == "compiled")
+            self._load_engine(wait=self.settings.engine == "compiled")
+
+    def wait_for_engine(self) -> None:
+        """Make the compiled engine ready for this planner's solves now (after ``setup()``), as
+        ``engine=compiled`` does at setup; with ``engine=auto`` it loads in the background
+        instead, and solves run on the Python engine until it is ready. Benchmarks call this
+        so that every timed solve runs on the same engine. Nothing to do where the compiled
+        engine does not apply."""
+        if self.settings.engine != "python" and not self._why_not_compiled():
+            self._load_engine(wait=True)
+
+    def _load_engine(self, wait: bool) -> None:
+        si = self.getSpaceInformation()
+        layout = layout_for(si.getStateSpace())
+        assert layout is not None  # (checked by _why_not_compiled)
+        load_engine(si, layout, wait=wait)
 
     def _check_policies(self) -> None:
         """Refuse combinations of policies and parameters that cannot do what they say."""

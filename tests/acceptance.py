@@ -380,11 +380,12 @@ class NeverValidChecker(ob.StateValidityChecker):
 
     def __init__(self, si: ob.SpaceInformation, start: ob.State, goal: ob.State) -> None:
         super().__init__(si)
-        self._equal = si.equalStates
-        self._start, self._goal = start, goal
+        # the query's values, not its states or si: the space information owns this checker, and
+        # a reference back to it would be a cycle through C++ that nanobind reports as leaked at exit
+        self._valid = {(start[0], start[1]), (goal[0], goal[1])}
 
     def isValid(self, state: ob.State) -> bool:
-        return self._equal(state, self._start) or self._equal(state, self._goal)
+        return (state[0], state[1]) in self._valid
 
 
 def termination_test(entry: PlannerEntry, env: Environment2D, limit: float = 0.1) -> tuple[float, bool]:

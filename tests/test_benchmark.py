@@ -8,6 +8,7 @@ import shutil
 import sqlite3
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -15,17 +16,13 @@ import pytest
 from ompl import geometric as og
 
 from ompl_balance.bench.compare import bench, compare_experiment, parse_planners
-from ompl_balance.bench.experiment import (
-    Experiment,
-    ExperimentError,
-    PlannerSpec,
-    ProblemSpec,
-    load_experiment,
-    run_seed,
-)
+from ompl_balance.bench.errors import ExperimentError
+from ompl_balance.bench.experiment import Experiment, PlannerSpec, run_seed
+from ompl_balance.bench.experiment_file import load_experiment
+from ompl_balance.bench.isolation import run_isolated
 from ompl_balance.bench.logs import write_logs
-from ompl_balance.bench.progress import ProgressSampler
-from ompl_balance.bench.runner import run_isolated
+from ompl_balance.bench.problems import ProblemSpec
+from ompl_balance.bench.progress_sampler import ProgressSampler
 from ompl_balance.bench.summary import summarize
 from ompl_balance.cli import main
 from ompl_balance.worlds.boxes import Problem
@@ -241,6 +238,27 @@ def test_progress_sampling_starts_at_begin_so_its_thread_start_is_not_timed():
     assert [int(sample[0]) for sample in sampler.samples] == list(range(1, len(times) + 1))
 
 
+def test_no_sample_is_kept_from_after_the_end_of_the_solve():
+    """The solve has returned at ``end()``: the thread's second round, held (by the check it
+    makes first) until after ``end()``, takes a sample that is not one of the solve's."""
+    rounds, in_second_round, ended = [], threading.Event(), threading.Event()
+
+    def check() -> None:
+        rounds.append(None)
+        if len(rounds) == 2:
+            in_second_round.set()
+            ended.wait(30.0)
+
+    sampler = ProgressSampler({"iterations INTEGER": lambda: "1"}, period=0.001, check=check)
+    with sampler:
+        sampler.begin()
+        assert in_second_round.wait(30.0)
+        elapsed = sampler.end()
+        ended.set()
+    times = [float(sample[1]) for sample in sampler.samples]
+    assert len(times) == 1 and times[0] <= elapsed  # the first round's sample only
+
+
 def test_a_sampler_never_begun_ends_with_its_block():
     sampler = ProgressSampler({"iterations INTEGER": lambda: "0"}, period=0.01)
     with sampler:
@@ -351,7 +369,7 @@ def test_a_changed_definition_runs_exactly_the_changed_cells_again(
             assert record["definition"] != earlier[key]["definition"]
         else:
             assert record == earlier[key]  # kept as it was
-    superseded = [json.loads(line) for line in (tmp_path / "superseded.jsonl").read_text().splitlines()]
+    superseded = [json.loads(line) for line in (tmp_path / "superseded" / "results.jsonl").read_text().splitlines()]
     assert sorted(json.dumps(r, sort_keys=True) for r in superseded) == sorted(
         json.dumps(r, sort_keys=True) for r in first if (r["problem"], r["planner"]) in changed_cells
     )

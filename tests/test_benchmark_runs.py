@@ -16,7 +16,8 @@ from ompl import base as ob
 from test_benchmark import deterministic
 
 from ompl_balance.bench.compare import bench
-from ompl_balance.bench.experiment import Experiment, PlannerSpec, ProblemSpec
+from ompl_balance.bench.experiment import Experiment, PlannerSpec
+from ompl_balance.bench.problems import ProblemSpec
 
 REPO = Path(__file__).resolve().parents[1]
 TESTS = Path(__file__).resolve().parent
@@ -178,11 +179,11 @@ def test_compare_interrupted_then_run_again_resumes(tmp_path):
         time.sleep(0.05)
     os.killpg(compare.pid, signal.SIGINT)  # Ctrl-C: the terminal signals the whole foreground group
     _, stderr = compare.communicate(timeout=60)
-    assert compare.returncode == 130
+    before = results.read_text().splitlines()
+    assert 5 <= len(before) < 60, f"compare should have been interrupted mid-way: {len(before)} runs; {stderr}"
+    assert compare.returncode == 130, stderr
     assert f"the finished runs are kept in {out}; run the same command again to resume" in stderr
     assert "Traceback" not in stderr
-    before = results.read_text().splitlines()
-    assert 5 <= len(before) < 60, "compare should have been interrupted mid-way"
 
     finished = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
     assert finished.returncode == 0, finished.stderr

@@ -319,8 +319,10 @@ def test_valid_sampler_policy_draws_from_the_space_informations_sampler():
 
 
 def test_passage_sampler_in_free_space_falls_back_to_uniform_targets():
-    # no obstacles: the passage sampler can never find a state near one (it used to stall
-    # the planner until the time limit)
+    # No obstacles: the passage sampler can never find a state near one (it used to stall the
+    # planner until the time limit); every iteration that asks it falls back to a uniform target.
+    # uniform_rate 0 makes every iteration ask it: at the default 0.1 an iteration may take a
+    # uniform target without asking, and in free space the first iteration already solves.
     space = ob.RealVectorStateSpace(2)
     space.setBounds(0.0, 1.0)
     ss = og.SimpleSetup(space)
@@ -329,10 +331,11 @@ def test_passage_sampler_in_free_space_falls_back_to_uniform_targets():
     start[0], start[1], goal[0], goal[1] = 0.05, 0.05, 0.95, 0.95
     ss.setStartAndGoalStates(start, goal)
     planner = GaussianPassageRRTConnect(ss.getSpaceInformation())
-    planner.setRange(0.1)  # several iterations, so the sampler is asked
+    assert planner.params().setParam("uniform_rate", "0")
     ss.setPlanner(planner)
     assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
-    assert planner.stats.sampler_rejections > 0
+    stats = planner.stats
+    assert stats.iterations >= 1 and stats.sampler_rejections == stats.iterations
 
 
 def test_swaps_by_cause_add_up():

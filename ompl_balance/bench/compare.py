@@ -1,14 +1,14 @@
 """Benchmarks: run an experiment into an output folder; ``compare`` is a ready-made experiment.
 
 :func:`bench` executes an :class:`~ompl_balance.bench.experiment.Experiment` (each run in its
-own process, see :mod:`ompl_balance.bench.runner`) and keeps everything in one folder::
+own process, see :mod:`ompl_balance.bench.isolation`) and keeps everything in one folder::
 
     OUT/experiment.json     the experiment and the package versions its runs execute with
     OUT/results.jsonl       one record per finished run, appended as runs finish
-    OUT/superseded.jsonl    runs recorded under an earlier definition of their cell (see resume)
     OUT/logs/*.log          one OMPL benchmark log per problem (logs.write_logs)
     OUT/benchmark.db        the logs converted by OMPL's own converter, with its views
     OUT/summary.md, .csv    medians, 95 % intervals, ratios to the baseline planner
+    OUT/superseded/         what earlier definitions produced: their runs (results.jsonl), logs
 
 Running the same experiment into the folder again runs only what is missing; runs of a
 cell whose definition changed (parameters, problem, limits, seed, versions) run again
@@ -26,10 +26,12 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ..worlds.boxes import PROBLEMS
-from .experiment import Experiment, PlannerSpec, ProblemSpec, mbm_problems
+from .experiment import Experiment, PlannerSpec
 from .logs import to_database, write_logs
-from .resume import RESULTS_FILE, claim, experiment_records
-from .runner import Progress, Record, ResultStore, sweep
+from .problems import problem_by_name
+from .results import Record, ResultStore
+from .resume import RESULTS_FILE, SUPERSEDED, claim, experiment_records, supersede_files
+from .scheduling import SweepCounts, missing_tasks, prepare_local_runs, sweep
 from .summary import format_csv, format_markdown, summarize
 
 STOCK_LABEL = "RRTConnect"
@@ -56,33 +58,25 @@ def default_planners() -> list[PlannerSpec]:
 def parse_planners(text: str) -> list[PlannerSpec]:
     """Planners from ``"RRTConnect,BalancedRRTConnect[max_tree_size_ratio=0.5;range=0.1]"``.
 
-    Each item is a planner or preset name, optionally with ``[name=value;...]``
-    parameter overrides; the item as written is its label.
+    Each item is a planner or preset name, optionally with ``[name=value;...]`` parameter
+    overrides (``;`` or ``,`` between them); the item as written is its label.
+    ``ValueError`` saying what could not be read.
     """
     specs = []
     for item in (part.strip() for part in re.split(r",(?![^\[]*\])", text)):
         match = re.fullmatch(r"([A-Za-z_][\w.]*)(?:\[(.*)\])?", item)
         if not match:
             raise ValueError(f"cannot read planner {item!r}; write NAME or NAME[param=value;...]")
-        params = dict(pair.split("=", 1) for pair in filter(None, (match.group(2) or "").split(";")) if "=" in pair)
+        params: dict[str, str] = {}
+        for pair in filter(None, (pair.strip() for pair in re.split(r"[;,]", match.group(2) or ""))):
+            name, equals, value = (part.strip() for part in pair.partition("="))
+            if not equals or not name:
+                raise ValueError(f"cannot read parameter {pair!r} of {item!r}; write NAME[param=value;...]")
+            if name in params:
+                raise ValueError(f"parameter {name!r} is given twice in {item!r}")
+            params[name] = value
         specs.append(PlannerSpec(item, match.group(1), params=params))
     return specs
-
-
-def compare_problem(name: str) -> ProblemSpec:
-    """A problem of ``compare`` by name: a built-in 2-D problem (``narrow_gap``) or a shipped
-    MotionBenchMaker Panda problem ``<scenario>.<id>`` (``box.001``); ``ValueError`` otherwise."""
-    if name in PROBLEMS:
-        return ProblemSpec(name, "builtin", name)
-    from ..worlds.mbm import SCENARIOS
-
-    scenario, _, number = name.rpartition(".")
-    if scenario in SCENARIOS and number.isdigit():
-        return mbm_problems(scenario, [int(number)])[0]
-    raise ValueError(
-        f"unknown problem {name!r}; built-in: {', '.join(PROBLEMS)}; or a MotionBenchMaker Panda problem "
-        f"<scenario>.<id> with scenario one of {', '.join(SCENARIOS)} (e.g. box.001)"
-    )
 
 
 def compare_experiment(
@@ -91,26 +85,34 @@ def compare_experiment(
     runs: int = 20,
     time_limit: float = 5.0,
     seed: int = COMPARE_SEED,
+    warm_up: bool = True,
 ) -> Experiment:
     """The ``ompl-balance compare`` experiment: the built-in 2-D problems and problem 1 of each
     MotionBenchMaker Panda scenario, stock RRTConnect as the baseline."""
     planners = list(planners or default_planners())
     return Experiment(
         name="compare",
-        problems=tuple(compare_problem(name) for name in problems),
+        problems=tuple(problem_by_name(name) for name in problems),
         planners=tuple(planners),
         runs=runs,
         time_limit=time_limit,
         seed=seed,
         baseline=STOCK_LABEL if any(p.label == STOCK_LABEL for p in planners) else "",
+        warm_up=warm_up,
     )
 
 
 def write_outputs(experiment: Experiment, records: Sequence[Record], out: Path) -> str:
-    """Logs, database and summary from ``records``; returns the markdown summary."""
+    """Logs, database and summary from ``records`` (files of earlier definitions go to ``superseded/``);
+    returns the markdown summary."""
     logs = write_logs(experiment, records, out / "logs")
+    supersede_files(out, "logs", logs)
+    database = out / "benchmark.db"
     if logs:
-        to_database(logs, out / "benchmark.db")
+        to_database(logs, database)
+    elif database.exists():  # no run counts yet: the database of an earlier definition goes
+        (out / SUPERSEDED).mkdir(exist_ok=True)
+        database.replace(out / SUPERSEDED / database.name)
     summaries = summarize(records, experiment.baseline_label, [p.label for p in experiment.planners])
     table = format_markdown(summaries, experiment.baseline_label)
     (out / "summary.md").write_text(table + "\n")
@@ -135,13 +137,19 @@ def bench(
     ``jobs`` runs at a time on this machine, or on the Dask cluster ``dask``. Runs the
     folder holds under another definition of their cell are superseded and run again;
     ``notify`` receives the notice saying so. Returns the experiment's records (all of
-    them, earlier sweeps' included).
+    them, earlier sweeps' included). :class:`~ompl_balance.bench.errors.ExperimentError` when
+    ``out`` cannot be this experiment's folder (see :func:`~ompl_balance.bench.resume.claim`).
+
+    The progress bar starts once the local runs' forkserver is ready (it imports the package
+    and compiles or loads its kernels once), so its estimate counts runs only.
     """
     out = Path(out)
     claimed = claim(out, experiment)
     if claimed.superseded:
         notify(claimed.message(out))
     store = ResultStore(out / RESULTS_FILE)
+    if dask is None and missing_tasks(experiment, store):
+        prepare_local_runs(experiment)
     bar = tqdm(
         total=len(experiment.tasks()),
         initial=claimed.kept,
@@ -151,7 +159,7 @@ def bench(
         dynamic_ncols=True,
     )
 
-    def show(record: Record, counts: Progress) -> None:
+    def show(record: Record, counts: SweepCounts) -> None:
         bar.update(1)
         bar.set_postfix(unsolved=counts.unsolved, crashed=counts.crashed, refresh=False)
 

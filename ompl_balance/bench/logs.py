@@ -32,7 +32,7 @@ from ompl import base as ob
 from ompl import tools as ot
 
 from .experiment import Experiment
-from .runner import STATUS_INDEX, Record
+from .results import STATUS_INDEX, Record
 
 
 def _status_enum_line() -> str:
@@ -53,20 +53,15 @@ def format_log(experiment: Experiment, problem: str, records: Sequence[Record], 
     planners = [p for p in experiment.planners if any(r["planner"] == p.label for r in records)]
     spec = next(p for p in experiment.problems if p.name == problem)
     named_by_getters = {r["planner"] for r in records if r.get("param_names") == "getters"}
-    setup = (
-        f"problem {problem}: {spec.kind} {spec.source}"
-        + (f" id {spec.problem_id}" if spec.kind == "mbm" else "")
-        + "\n"
-        + "".join(
-            f"planner {p.label}: {p.name or p.factory} {dict(p.params)}"
-            + (
-                " (parameters named after its get/set methods: OMPL's declared names are not known)"
-                if p.label in named_by_getters
-                else ""
-            )
-            + "\n"
-            for p in planners
+    setup = f"problem {problem}: {spec.description}\n" + "".join(
+        f"planner {p.label}: {p.name or p.factory} {dict(p.params)}"
+        + (
+            " (parameters named after its get/set methods: OMPL's declared names are not known)"
+            if p.label in named_by_getters
+            else ""
         )
+        + "\n"
+        for p in planners
     )
     lines = [
         f"OMPL version {metadata.version('ompl')}",

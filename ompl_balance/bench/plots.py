@@ -1,19 +1,26 @@
 """Plots of a benchmark output folder (matplotlib: ``pip install 'ompl-balance[plot]'``).
 
-:func:`plot_folder` writes into ``OUT/plots/``:
+:func:`plot_folder` writes into ``OUT/plots/`` (files of an earlier definition go to
+``OUT/superseded/plots/``):
 
-* ``<problem>.png``: box plots of time and of validity checks per planner;
-* ``success_vs_time.png``: per problem, the fraction of runs solved within ``t``
-  seconds, ``t`` over the range of the observed times (log scale when they span more
-  than a decade);
-* ``progress_<problem>.png`` for problems where planners report a best cost while they
-  run (RRT*): the median over runs of the best cost so far against time, per planner;
+* ``<problem>.png``: per planner, how its runs ended (solved, not solved, crashed or
+  killed) and the success rate; the time to a solution and the validity checks of its
+  solved runs, as box plots with every run drawn as a point;
+* ``success_vs_time.png``: per problem, the fraction of runs that have a solution at time
+  ``t``, for ``t`` up to the time limit (log scale when the solutions span more than a
+  decade); crashed and unsolved runs count as runs without one;
+* ``progress_<problem>.png`` for problems where planners that keep improving their
+  solution (RRT*, BIT*, AORRTC, BallRadiusRRTstar) ran: the median over runs of the best
+  cost so far against time, per such planner;
 * ``summary.md`` and ``summary.csv``: medians, bootstrap 95 % intervals, ratios to
   the baseline planner (and pooled per scenario for MotionBenchMaker problems);
 * ``trees_<problem>.png`` for each built-in 2-D problem: the start tree and the goal
   tree of ``BalancedRRTConnect`` with balancing on and off, seeded alike and stopped
   after the same number of iterations.
 
+*Time to a solution* is the run's ``time`` for planners that stop at their first solution;
+for planners that keep improving it until the time limit, whose ``time`` is the limit, it
+is the time of the first progress sample (every 0.05 s) that has a solution's cost.
 Curves differ by colour, marker and line style, so they stay apart where they overlap
 and in grey print.
 """
@@ -22,6 +29,7 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
 from collections.abc import Iterator, Sequence
 from itertools import count
 from pathlib import Path
@@ -33,15 +41,20 @@ from ompl import base as ob
 from ..core.planner import GOAL_TAG, START_TAG
 from ..planners import BalancedRRTConnect
 from ..worlds.boxes import PROBLEMS
-from .experiment import Experiment, ExperimentError, MissingExtraError
-from .resume import experiment_records
-from .runner import Record, ResultStore
+from .errors import ExperimentError, MissingExtraError
+from .experiment import Experiment
+from .problems import PROBLEM_KINDS
+from .results import Record, ResultStore
+from .resume import experiment_records, supersede_files
 from .summary import format_csv, format_markdown, pooled_by_scenario, summarize
 
 MATPLOTLIB_MISSING = "plots need matplotlib: pip install 'ompl-balance[plot]'"
 
 #: Progress properties that carry the best cost so far (RRTstar: REAL, BITstar: DOUBLE).
 BEST_COST_PROPERTIES = ("best cost REAL", "best cost DOUBLE")
+
+#: How a run ended, in the order the outcome bars stack them, with their colours.
+OUTCOMES = (("solved", "tab:green"), ("not solved", "tab:orange"), ("crashed or killed", "tab:red"))
 
 
 def require_matplotlib() -> None:
@@ -71,46 +84,132 @@ def _styles() -> Iterator[dict[str, Any]]:
         yield {"color": colours[i % 8], "marker": markers[i % 8], "linestyle": lines[i % 4]}
 
 
-def _time_axis(axis: Any, times: Sequence[float]) -> None:
-    """Limit a time axis to the observed range, on a log scale when it spans more than a decade."""
-    positive = [t for t in times if t > 0 and math.isfinite(t)]
-    if not positive:
-        return
-    low, high = min(positive), max(positive)
-    if high > 10 * low:
-        from matplotlib.ticker import NullFormatter
-
-        axis.set_xscale("log")
-        axis.set_xlim(low / 1.2, high * 1.2)
-        axis.xaxis.set_minor_formatter(NullFormatter())  # labels at the decades only: no overlaps
-    else:
-        margin = 0.05 * (high - low) or 0.05 * high
-        axis.set_xlim(max(0.0, low - margin), high + margin)
+def outcome(record: Record) -> str:
+    """How a run ended: one of the names of :data:`OUTCOMES`."""
+    if record["status"] == "CRASH" or record["error"]:
+        return "crashed or killed"
+    return "solved" if record["properties"].get("solved BOOLEAN") else "not solved"
 
 
-def _by_planner(records: Sequence[Record], labels: Sequence[str], name: str) -> list[list[float]]:
-    return [
-        [r["properties"][name] for r in records if r["planner"] == label and r["properties"].get(name) is not None]
-        for label in labels
-    ]
+def _best_cost_column(record: Record) -> int | None:
+    names = (record.get("progress") or {}).get("properties", [])
+    return next((names.index(n) for n in BEST_COST_PROPERTIES if n in names), None)
 
 
-def plot_problem(records: Sequence[Record], problem: str, labels: Sequence[str], path: Path) -> Path:
-    """Box plots of time (s) and validity checks per planner on ``problem``."""
+def time_to_solution(record: Record) -> float | None:
+    """Seconds from the start of the solve to the run's (first) exact solution; ``None`` when
+    it has none. For a planner that keeps improving its solution, the time of the first
+    progress sample with a finite best cost (sampled every 0.05 s; the end of the solve when
+    none has one)."""
+    if outcome(record) != "solved":
+        return None
+    end = float(record["properties"]["time REAL"])
+    column = _best_cost_column(record)
+    if not record.get("improves_cost") or column is None:
+        return end
+    progress = record["progress"]
+    time_column = progress["properties"].index("time REAL")
+    for sample in progress["samples"]:
+        if sample[column] and math.isfinite(float(sample[column])):
+            return float(sample[time_column])
+    return end
+
+
+def _log_axis(axis: Any, which: str, low: float, high: float) -> None:
+    """A log scale on ``which`` (``"x"``/``"y"``) for values from ``low`` to ``high``, labelled at
+    1, 2 and 5 times each power of ten when it spans up to two decades, at 1 and 3 up to
+    three, else at the powers of ten: always several labels, never crowded."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    decades = math.log10(high / low)
+    subs = (1.0, 2.0, 5.0) if decades <= 2 else (1.0, 3.0) if decades <= 3 else (1.0,)
+    scaled = axis.xaxis if which == "x" else axis.yaxis
+    (axis.set_xscale if which == "x" else axis.set_yscale)("log")
+    scaled.set_major_locator(LogLocator(subs=subs))
+    scaled.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    scaled.set_minor_formatter(NullFormatter())
+
+
+def _spans_a_decade(values: Sequence[float]) -> bool:
+    positive = [v for v in values if v > 0]
+    return bool(positive) and max(positive) > 10 * min(positive)
+
+
+def _outcome_counts(runs: Sequence[Record]) -> dict[str, int]:
+    ended = [outcome(r) for r in runs]
+    return {name: ended.count(name) for name, _ in OUTCOMES}
+
+
+def plot_problem(records: Sequence[Record], problem: str, labels: Sequence[str], time_limit: float, path: Path) -> Path:
+    """How each planner's runs on ``problem`` ended, and the time to a solution and the validity
+    checks of its solved runs (box plots, every run a point)."""
     plt = _pyplot()
     mine = [r for r in records if r["problem"] == problem]
-    figure, axes = plt.subplots(1, 2, figsize=(4 + 1.2 * len(labels), 4.5), layout="constrained")
-    for axis, (name, title) in zip(axes, (("time REAL", "time (s)"), ("validity checks INTEGER", "validity checks"))):
-        values = _by_planner(mine, labels, name)
-        axis.boxplot([v or [math.nan] for v in values], showfliers=True)
-        axis.set_xticks(range(1, len(labels) + 1), labels, rotation=20, ha="right", fontsize=8)
-        if all(x > 0 for v in values for x in v):
-            axis.set_yscale("log")
-        axis.set_ylabel(title)
-    figure.suptitle(f"{problem}: time and validity checks per run ({len(mine)} runs)")
+    labels = [label for label in labels if any(r["planner"] == label for r in mine)]
+    runs = {label: [r for r in mine if r["planner"] == label] for label in labels}
+    solved = {label: [r for r in runs[label] if outcome(r) == "solved"] for label in labels}
+    figure, axes = plt.subplots(1, 3, figsize=(15, 2.2 + 0.4 * len(labels)), layout="constrained", squeeze=False)
+    bars, times, checks = axes[0]
+    positions = np.arange(len(labels))
+    left = np.zeros(len(labels))
+    for name, colour in OUTCOMES:
+        widths = np.array([_outcome_counts(runs[label])[name] for label in labels])
+        bars.barh(positions, widths, left=left, color=colour, label=name)
+        left += widths
+    for position, label in zip(positions, labels):
+        rate = len(solved[label]) / len(runs[label])
+        bars.text(left[position], position, f" {rate:.0%} solved", va="center", fontsize=8)
+    bars.set_yticks(positions, labels, fontsize=8)
+    bars.invert_yaxis()
+    bars.set_xlim(0, 1.35 * max(left))
+    bars.set_xlabel("runs")
+    bars.set_title("how the runs ended", fontsize=9)
+    bars.legend(fontsize=7, ncols=3, loc="upper center", bbox_to_anchor=(0.5, -0.12 - 0.3 / len(labels)))
+    for axis, values, title in (
+        (times, [[time_to_solution(r) for r in solved[label]] for label in labels], "time to a solution (s)"),
+        (
+            checks,
+            [[r["properties"]["validity checks INTEGER"] for r in solved[label]] for label in labels],
+            "validity checks of the whole solve",
+        ),
+    ):
+        _box_plot(axis, values, labels)
+        axis.set_title(f"{title}, solved runs", fontsize=9)
+    counts = {len(r) for r in runs.values()}
+    per_planner = f"{counts.pop()} runs per planner" if len(counts) == 1 else "runs per planner as on the bars"
+    figure.suptitle(f"{problem}: {per_planner}, time limit {time_limit:g} s", fontsize=10)
     figure.savefig(path, dpi=120)
     plt.close(figure)
     return path
+
+
+def _horizontal() -> dict[str, Any]:
+    """``boxplot``'s argument for horizontal boxes (``orientation`` since matplotlib 3.10, ``vert`` before)."""
+    import matplotlib
+
+    major, minor = (int(part) for part in matplotlib.__version__.split(".")[:2])
+    return {"orientation": "horizontal"} if (major, minor) >= (3, 10) else {"vert": False}
+
+
+def _box_plot(axis: Any, values: Sequence[Sequence[float | None]], labels: Sequence[str]) -> None:
+    """Horizontal box plots of ``values`` per label, each value a point; "none solved" where empty."""
+    positions = np.arange(len(labels))
+    present = [[v for v in cell if v is not None] for cell in values]
+    filled = [i for i, cell in enumerate(present) if cell]
+    if filled:
+        axis.boxplot([present[i] for i in filled], positions=positions[filled], showfliers=False, **_horizontal())
+        jitter = np.random.default_rng(0)
+        for i in filled:
+            offsets = jitter.uniform(-0.15, 0.15, len(present[i]))
+            axis.scatter(present[i], i + offsets, s=6, color="tab:blue", alpha=0.5, zorder=3)
+        every = [v for i in filled for v in present[i]]
+        if _spans_a_decade(every) and min(every) > 0:
+            _log_axis(axis, "x", min(every), max(every))
+    for i, cell in enumerate(present):
+        if not cell:
+            axis.text(0.02, i, "none solved", transform=axis.get_yaxis_transform(), va="center", fontsize=8)
+    axis.set_yticks(positions, labels, fontsize=8)
+    axis.set_ylim(len(labels) - 0.5, -0.5)
 
 
 def _grid(count: int) -> tuple[int, int]:
@@ -118,36 +217,61 @@ def _grid(count: int) -> tuple[int, int]:
     return -(-count // columns), columns
 
 
+def _time_grid(axis: Any, solution_times: Sequence[float], limit: float) -> np.ndarray:
+    """Set a time axis from the first solution to ``limit`` (log when that spans more than a decade);
+    returns the times to evaluate curves at."""
+    first = min((t for t in solution_times if t > 0), default=limit)
+    if _spans_a_decade([first, limit]):
+        _log_axis(axis, "x", first, limit)
+        axis.set_xlim(first / 1.2, limit * 1.05)
+        return np.geomspace(first / 1.2, limit, 300)
+    axis.set_xlim(0.0, limit * 1.02)
+    return np.linspace(0.0, limit, 300)
+
+
+def fraction_solved(runs: Sequence[Record], times: np.ndarray) -> np.ndarray:
+    """The fraction of ``runs`` that have a solution at each of ``times`` (s since their solve
+    began; :func:`time_to_solution`): unsolved and crashed runs count as runs without one."""
+    solved_at = np.array([t for t in map(time_to_solution, runs) if t is not None])
+    return np.array([(solved_at <= t).sum() / len(runs) for t in times])
+
+
 def plot_success(records: Sequence[Record], experiment: Experiment, path: Path) -> Path:
-    """Per problem, the fraction of runs solved within ``t`` seconds over the observed times."""
+    """Per problem, the fraction of runs with a solution at time ``t``, up to the time limit."""
     plt = _pyplot()
     problems = [p.name for p in experiment.problems if any(r["problem"] == p.name for r in records)]
     rows, columns = _grid(len(problems))
     figure, axes = plt.subplots(
-        rows, columns, figsize=(4 * columns, 3.2 * rows + 0.6), squeeze=False, layout="constrained"
+        rows, columns, figsize=(4 * columns, 3 * rows + 1.2), squeeze=False, layout="constrained"
     )
+    handles: dict[str, Any] = {}
     for axis, problem in zip(axes.flat, problems):
         mine = [r for r in records if r["problem"] == problem]
-        times = [r["properties"]["time REAL"] for r in mine if r["properties"].get("time REAL") is not None]
-        _time_axis(axis, times)
-        low, high = axis.get_xlim()
-        grid = np.geomspace(low, high, 200) if axis.get_xscale() == "log" else np.linspace(low, high, 200)
-        for planner, style in zip(experiment.planners, _styles()):
+        solved_at = [t for t in map(time_to_solution, mine) if t is not None]
+        grid = _time_grid(axis, solved_at, experiment.time_limit)
+        for index, (planner, style) in enumerate(zip(experiment.planners, _styles())):
             runs = [r for r in mine if r["planner"] == planner.label]
             if not runs:
                 continue
-            solved_at = np.array([r["properties"]["time REAL"] for r in runs if r["properties"].get("solved BOOLEAN")])
-            fraction = [(solved_at <= t).sum() / len(runs) for t in grid]
-            axis.plot(grid, fraction, label=planner.label, markevery=20, markersize=4, **style)
+            # markers staggered from curve to curve, so curves on top of each other stay apart
+            (line,) = axis.plot(
+                grid, fraction_solved(runs, grid), markevery=((7 * index) % 50, 50), markersize=4, **style
+            )
+            handles[planner.label] = line
         axis.set_title(problem, fontsize=9)
         axis.set_xlabel("time (s)")
         axis.set_ylim(-0.02, 1.05)
     for axis in axes[:, 0]:
-        axis.set_ylabel("fraction solved")
-    axes.flat[0].legend(fontsize=7)
+        axis.set_ylabel("fraction of the runs solved")
     for axis in list(axes.flat)[len(problems) :]:
         axis.set_visible(False)
-    figure.suptitle(f"{experiment.name}: runs solved within t seconds (time limit {experiment.time_limit:g} s)")
+    figure.legend(
+        list(handles.values()), list(handles), loc="outside lower center", ncols=min(4, len(handles)), fontsize=8
+    )
+    figure.suptitle(
+        f"{experiment.name}: fraction of the runs with a solution by time t (time limit {experiment.time_limit:g} s)",
+        fontsize=10,
+    )
     figure.savefig(path, dpi=120)
     plt.close(figure)
     return path
@@ -157,19 +281,20 @@ def _best_cost_series(record: Record) -> tuple[np.ndarray, np.ndarray] | None:
     """``(times, best costs)`` of a run whose planner reports its best cost while it runs: the
     progress samples (``inf`` before a path), then the cost of its solution when the solve
     ended (``time REAL``). ``None`` for a run without that progress property."""
-    progress = record.get("progress") or {"properties": [], "samples": []}
-    names = progress["properties"]
-    column = next((names.index(n) for n in BEST_COST_PROPERTIES if n in names), None)
+    column = _best_cost_column(record)
     if column is None or record["properties"].get("time REAL") is None:
         return None
-    time_column = names.index("time REAL")
+    progress = record["progress"]
+    time_column = progress["properties"].index("time REAL")
     times = [float(sample[time_column]) for sample in progress["samples"]]
     costs = [float(sample[column]) if sample[column] else math.inf for sample in progress["samples"]]
     end = record["properties"]["time REAL"]
     solved = record["properties"].get("solved BOOLEAN") and "solution length REAL" in record["properties"]
     if not times or end > times[-1]:
+        last = (costs or [math.inf])[-1]
+        # the samples hold 6 significant digits (as OMPL writes them): the end's cost never exceeds the last one
         times.append(end)
-        costs.append(record["properties"]["solution length REAL"] if solved else (costs or [math.inf])[-1])
+        costs.append(min(last, record["properties"]["solution length REAL"]) if solved else last)
     return np.array(times), np.array(costs)
 
 
@@ -189,21 +314,28 @@ def median_best_cost(records: Sequence[Record], grid: np.ndarray) -> np.ndarray:
     return np.median(np.array(values), axis=0)
 
 
+PROGRESS_CAPTION = (
+    "Median over each planner's runs of the best path cost found so far, sampled every 0.05 s while it plans "
+    "(a run's last value holds after it ends); the line starts once half of the runs have a solution. Only "
+    "planners that keep improving their solution are drawn."
+)
+
+
 def plot_progress(records: Sequence[Record], experiment: Experiment, problem: str, path: Path) -> Path | None:
-    """Median best cost against time per planner that reports it while it runs, on ``problem``;
+    """Median best cost against time per planner that keeps improving its solution, on ``problem``;
     ``None`` when no such planner has a median path at any time."""
-    series = {id(r): s for r in records if r["problem"] == problem and (s := _best_cost_series(r)) is not None}
-    mine = [r for r in records if id(r) in series]
-    if not mine:
+    improving = [
+        r for r in records if r["problem"] == problem and r.get("improves_cost") and _best_cost_series(r) is not None
+    ]
+    if not improving:
         return None
     plt = _pyplot()
-    figure, axis = plt.subplots(figsize=(7, 4.5), layout="constrained")
-    _time_axis(axis, [t for times, _ in series.values() for t in times])
-    low, high = axis.get_xlim()
-    grid = np.geomspace(low, high, 300) if axis.get_xscale() == "log" else np.linspace(low, high, 300)
+    figure, axis = plt.subplots(figsize=(8, 5), layout="constrained")
+    first = [t for r in improving if (t := time_to_solution(r)) is not None]
+    grid = _time_grid(axis, first, experiment.time_limit)
     drawn = False
     for planner, style in zip(experiment.planners, _styles()):
-        runs = [r for r in mine if r["planner"] == planner.label]
+        runs = [r for r in improving if r["planner"] == planner.label]
         median = median_best_cost(runs, grid)
         if runs and np.isfinite(median).any():
             shown = np.where(np.isfinite(median), median, np.nan)  # no line until half the runs have a path
@@ -212,10 +344,15 @@ def plot_progress(records: Sequence[Record], experiment: Experiment, problem: st
     if not drawn:
         plt.close(figure)
         return None
+    axis.ticklabel_format(axis="y", useOffset=False)
+    low, high = axis.dataLim.y0, axis.dataLim.y1
+    margin = 0.1 * max(high - low, 0.01 * abs(high))  # a flat median shows as flat, not as noise magnified
+    axis.set_ylim(low - margin, high + margin)
     axis.set_xlabel("time (s)")
     axis.set_ylabel("median best cost (path length)")
-    axis.legend(fontsize=8)
-    figure.suptitle(f"{problem}: median best cost while planning (sampled every 0.05 s, then at the end)")
+    axis.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    axis.set_title(f"{problem}: median best cost while planning", fontsize=10)
+    figure.supxlabel(textwrap.fill(PROGRESS_CAPTION, 140), fontsize=8)
     figure.savefig(path, dpi=120)
     plt.close(figure)
     return path
@@ -252,7 +389,7 @@ TREES_CAPTION = (
 def plot_trees(problem: str, iterations: int, path: Path, seed: int = 1) -> Path:
     """Start tree (blue) and goal tree (orange) of balanced vs alternating growth, side by side."""
     plt = _pyplot()
-    figure, axes = plt.subplots(1, 2, figsize=(10, 5.8), layout="constrained")
+    figure, axes = plt.subplots(1, 2, figsize=(10, 6.2), layout="constrained")
     query = PROBLEMS[problem]
     for axis, balance in zip(axes, (True, False)):
         data, done = grow_trees(problem, balance, iterations, seed)
@@ -266,13 +403,7 @@ def plot_trees(problem: str, iterations: int, path: Path, seed: int = 1) -> Path
             for i in np.flatnonzero(tags == tag):
                 for j in data.getEdges(int(i)):
                     axis.plot(points[[i, j], 0], points[[i, j], 1], color=colour, linewidth=0.6)
-            axis.scatter(
-                points[tags == tag, 0],
-                points[tags == tag, 1],
-                s=3,
-                color=colour,
-                label=f"{name} ({(tags == tag).sum()} states)",
-            )
+            axis.scatter(points[tags == tag, 0], points[tags == tag, 1], s=3, color=colour, label=name)
         axis.plot(*query.start, marker="*", markersize=16, color="tab:green", markeredgecolor="black", label="start")
         axis.plot(*query.goal, marker="X", markersize=13, color="tab:red", markeredgecolor="black", label="goal")
         axis.set_xlim(0, 1)
@@ -280,13 +411,13 @@ def plot_trees(problem: str, iterations: int, path: Path, seed: int = 1) -> Path
         axis.set_aspect("equal")
         ending = "solved after" if done < iterations else "stopped after"
         axis.set_title(
-            f"{'balanced' if balance else 'alternating'} growth, {ending} {done} iteration{'s' * (done != 1)}",
+            f"{'balanced' if balance else 'alternating'} growth, {ending} {done} iteration{'s' * (done != 1)}\n"
+            f"start tree {(tags == START_TAG).sum()} states, goal tree {(tags == GOAL_TAG).sum()} states",
             fontsize=10,
         )
-        axis.legend(loc="lower right", fontsize=8, markerscale=0.6)
+        axis.legend(loc="upper center", bbox_to_anchor=(0.5, -0.06), ncols=4, fontsize=8, markerscale=0.8)
     figure.suptitle(f"{problem}: BalancedRRTConnect with balance_tree_sizes on / off, seed {seed}")
-    figure.text(0.5, 0.005, TREES_CAPTION, ha="center", va="bottom", fontsize=8, wrap=True)
-    figure.get_layout_engine().set(rect=(0, 0.07, 1, 0.93))
+    figure.supxlabel(textwrap.fill(TREES_CAPTION, 160), fontsize=8)
     figure.savefig(path, dpi=120)
     plt.close(figure)
     return path
@@ -307,35 +438,40 @@ def _read_experiment(out: Path) -> Experiment:
 
 
 def plot_folder(out: str | Path, baseline: str | None = None, tree_iterations: int = 300) -> list[Path]:
-    """All plots and summary tables of a ``bench``/``compare -o`` output folder; returns the files written."""
+    """All plots and summary tables of a ``bench``/``compare -o`` output folder; returns the files
+    written (those an earlier call wrote that this one does not go to ``superseded/plots``)."""
     out = Path(out)
     experiment = _read_experiment(out)
+    labels = [p.label for p in experiment.planners]
+    baseline = baseline or experiment.baseline_label
+    if baseline not in labels:
+        raise ExperimentError("baseline", f"{baseline!r} is not a planner of {out}; its planners: {', '.join(labels)}")
     records = experiment_records(experiment, ResultStore(out / "results.jsonl"))
     folder = out / "plots"
     folder.mkdir(exist_ok=True)
-    labels = [p.label for p in experiment.planners]
-    baseline = baseline or experiment.baseline_label
     summaries = summarize(records, baseline, labels)
     (folder / "summary.md").write_text(format_markdown(summaries, baseline) + "\n")
     (folder / "summary.csv").write_text(format_csv(summaries))
     written = [folder / "summary.md", folder / "summary.csv"]
-    if any(problem.kind == "mbm" for problem in experiment.problems):  # MotionBenchMaker: also per scenario
+    if any(PROBLEM_KINDS[problem.kind].scenarios for problem in experiment.problems):  # also per scenario
         pooled = summarize(pooled_by_scenario(records), baseline, labels)
         (folder / "summary_by_scenario.md").write_text(format_markdown(pooled, baseline) + "\n")
         (folder / "summary_by_scenario.csv").write_text(format_csv(pooled))
         written += [folder / "summary_by_scenario.md", folder / "summary_by_scenario.csv"]
-    if not records:
-        return written
-    for problem in experiment.problems:
-        if any(r["problem"] == problem.name for r in records):
-            written.append(plot_problem(records, problem.name, labels, folder / f"{problem.name}.png"))
-            progress = plot_progress(records, experiment, problem.name, folder / f"progress_{problem.name}.png")
-            if progress is not None:
-                written.append(progress)
-    written.append(plot_success(records, experiment, folder / "success_vs_time.png"))
-    for problem in experiment.problems:
-        if problem.kind == "builtin":
-            written.append(
-                plot_trees(problem.source, tree_iterations, folder / f"trees_{problem.name}.png", experiment.seed)
-            )
+    if records:
+        for problem in experiment.problems:
+            if any(r["problem"] == problem.name for r in records):
+                written.append(
+                    plot_problem(records, problem.name, labels, experiment.time_limit, folder / f"{problem.name}.png")
+                )
+                progress = plot_progress(records, experiment, problem.name, folder / f"progress_{problem.name}.png")
+                if progress is not None:
+                    written.append(progress)
+        written.append(plot_success(records, experiment, folder / "success_vs_time.png"))
+        for problem in experiment.problems:
+            if problem.kind == "builtin":
+                written.append(
+                    plot_trees(problem.source, tree_iterations, folder / f"trees_{problem.name}.png", experiment.seed)
+                )
+    supersede_files(out, "plots", written)
     return written

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .runner import Record
+from .results import Record
 
 BOOTSTRAP_SAMPLES = 2000
 Interval = tuple[float, float]

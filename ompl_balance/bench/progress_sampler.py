@@ -13,14 +13,15 @@ Where the properties come from (:func:`progress_properties`):
   tree sizes);
 * stock planners: OMPL 2.0's bindings cannot return ``getPlannerProgressProperties()``, so
   the properties are rebuilt from the bound methods that read the same counters
-  (:data:`STOCK_PROGRESS`): ``RRTstar`` and its informed variants, ``BITstar`` and
-  ``PRM``. These methods are safe to call during ``solve`` from Python because the run's
+  (:data:`STOCK_PROGRESS`): ``RRTstar`` and its informed variants, ``BITstar``, ``AORRTC``
+  and ``PRM``. These methods are safe to call during ``solve`` from Python because the run's
   validity checker is a Python callable (the run counts checks), so the solving thread
   returns to Python, where the sampler can take its turn, at every check.
 """
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Callable
@@ -58,6 +59,11 @@ def _bitstar_progress(planner: Any) -> ProgressProperties:
     }
 
 
+def _aorrtc_progress(planner: Any) -> ProgressProperties:
+    """``AORRTC``'s best cost (AORRTC.cpp declares no progress properties; ``bestCost`` is bound)."""
+    return {"best cost REAL": lambda: _real(planner.bestCost().value())}
+
+
 def _prm_progress(planner: Any) -> ProgressProperties:
     """The bound ones of ``PRM``'s properties (PRM.cpp: ``milestone count``, ``edge count``)."""
     return {
@@ -70,8 +76,14 @@ def _prm_progress(planner: Any) -> ProgressProperties:
 STOCK_PROGRESS: tuple[tuple[type, Callable[[Any], ProgressProperties]], ...] = (
     (og.RRTstar, _rrtstar_progress),  # InformedRRTstar and SORRTstar derive from it
     (og.BITstar, _bitstar_progress),
+    (og.AORRTC, _aorrtc_progress),
     (og.PRM, _prm_progress),
 )
+
+#: Stock planners that keep improving their solution until their termination condition ends
+#: the solve, and whose best cost the bindings can read (``PRMstar`` improves too, but its
+#: cost is not bound).
+STOCK_IMPROVING = (og.RRTstar, og.BITstar, og.AORRTC)
 
 
 def progress_properties(planner: ob.Planner) -> ProgressProperties:
@@ -84,13 +96,24 @@ def progress_properties(planner: ob.Planner) -> ProgressProperties:
     return {}
 
 
-class ProgressSampler:
-    """Samples ``properties`` every ``period`` seconds in a thread, from :meth:`begin` to the
-    end of the ``with`` block.
+def improves_cost(planner: ob.Planner) -> bool:
+    """Whether ``planner`` keeps improving its solution's cost until its time limit (OMPL's
+    ``optimizingPaths``; for stock planners :data:`STOCK_IMPROVING`, as OMPL 2.0's bindings
+    cannot return their ``PlannerSpecs``)."""
+    try:
+        return bool(planner.getSpecs().optimizingPaths)
+    except TypeError:
+        return isinstance(planner, STOCK_IMPROVING)
 
-    The thread starts when the block is entered and waits for :meth:`begin`, so that its
-    start (about half a millisecond for a Python thread) is not part of the solve the caller
-    times; sample times count from :meth:`begin`. ``names`` are ``"time REAL"`` and the
+
+class ProgressSampler:
+    """Samples ``properties`` every ``period`` seconds in a thread, from :meth:`begin` to :meth:`end`.
+
+    The thread starts when the ``with`` block is entered and waits for :meth:`begin`, so
+    that its start (about half a millisecond for a Python thread) is not part of the solve
+    the caller times, and it stops with the block. Sample times count from :meth:`begin`;
+    a sample taken after :meth:`end` (the solve had returned) is dropped, as OMPL's
+    Benchmark takes none after ``solve`` returns. ``names`` are ``"time REAL"`` and the
     property names, sorted (the order of OMPL's log); ``samples`` one list of values per
     sample in that order. A property whose function raises is recorded empty for that sample.
 
@@ -104,12 +127,14 @@ class ProgressSampler:
         self.period = period
         self.names = sorted(["time REAL", *properties])
         self.samples: list[list[str]] = []
+        self._times: list[float] = []  # s since begin() of each sample
         self._properties = properties
         self._check = check
         self._began_event = threading.Event()
         self._done = threading.Event()
         self._thread = threading.Thread(target=self._sample, name="progress sampler", daemon=True)
         self._began = 0.0
+        self._ended = math.inf  # s since begin() when end() was called
 
     def __enter__(self) -> ProgressSampler:
         if self._properties or self._check is not None:
@@ -122,6 +147,12 @@ class ProgressSampler:
         self._began_event.set()
         return self._began
 
+    def end(self) -> float:
+        """Stop sampling now; returns the seconds since :meth:`begin`."""
+        self._ended = time.perf_counter() - self._began
+        self._done.set()
+        return self._ended
+
     def __exit__(
         self, kind: type[BaseException] | None, error: BaseException | None, traceback: TracebackType | None
     ) -> None:
@@ -129,6 +160,7 @@ class ProgressSampler:
         self._began_event.set()  # a thread still waiting for begin() ends at once
         if self._thread.is_alive():
             self._thread.join()
+        self.samples = [sample for sample, at in zip(self.samples, self._times) if at <= self._ended]
 
     def _sample(self) -> None:
         self._began_event.wait()
@@ -137,10 +169,16 @@ class ProgressSampler:
                 self._check()
             if not self._properties:
                 continue
-            values = {"time REAL": repr(time.perf_counter() - self._began)}
-            for name, read in self._properties.items():
-                try:
-                    values[name] = read()
-                except Exception:  # a counter not readable yet: leave the sample empty there
-                    values[name] = ""
+            at = time.perf_counter() - self._began
+            values = {name: _read(read) for name, read in self._properties.items()}
+            values["time REAL"] = repr(at)
             self.samples.append([values[name] for name in self.names])
+            self._times.append(at)
+
+
+def _read(read: Callable[[], str]) -> str:
+    """A property's value now, or empty when it cannot be read yet."""
+    try:
+        return read()
+    except Exception:  # a counter not readable yet: leave the sample empty there
+        return ""

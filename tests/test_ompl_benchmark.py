@@ -1,0 +1,66 @@
+"""OMPL's own ompl.tools.Benchmark with the package's planners: run through run_ompl_benchmark, its
+log holds their parameters and graph sizes (read back with OMPL's own log converter)."""
+
+from __future__ import annotations
+
+import sqlite3
+
+from ompl import geometric as og
+from ompl import tools as ot
+
+from ompl_balance import BalancedRRTConnect, BallRadiusRRTstar
+from ompl_balance.bench.ompl_benchmark import run_ompl_benchmark
+from ompl_balance.worlds.boxes import get_problem
+
+RUNS = 3
+
+
+def test_the_log_of_ompls_benchmark_holds_the_package_planners_parameters_and_graphs(tmp_path):
+    ss = get_problem("narrow_gap").setup()
+    si = ss.getSpaceInformation()
+    benchmark = ot.Benchmark(ss, "filled")
+    balanced = BalancedRRTConnect(si, name="ratio_0.5")
+    balanced.setMaxTreeSizeRatio(0.5)
+    default = BalancedRRTConnect(si, name="ratio_1")
+    rrtstar = BallRadiusRRTstar(si)
+    stock = og.RRTConnect(si)
+    for planner in (balanced, default, rrtstar, stock):
+        benchmark.addPlanner(planner)
+    own_events = []
+    graphs: dict[str, list[tuple[int, int]]] = {}
+
+    def post_run(planner, run):
+        own_events.append(planner.getName())
+        if hasattr(planner, "stats"):  # the planner's own count of its two trees, or of its tree
+            stats = planner.stats
+            trees = (
+                stats.start_tree_size + stats.goal_tree_size if hasattr(stats, "goal_tree_size") else stats.tree_size
+            )
+            graphs.setdefault(planner.getName(), []).append((trees, stats.iterations))
+
+    request = ot.Request(0.5, 1000.0, RUNS)
+    request.displayProgress = False
+    run_ompl_benchmark(benchmark, request, post_run=post_run)
+    log = tmp_path / "filled.log"
+    benchmark.saveResultsToFile(str(log))
+    database = tmp_path / "filled.db"
+    ot.readBenchmarkLog(str(database), [str(log)], False)
+
+    assert (
+        own_events == ["ratio_0.5"] * RUNS + ["ratio_1"] * RUNS + ["BallRadiusRRTstar"] * RUNS + ["RRTConnect"] * RUNS
+    )
+    with sqlite3.connect(database) as db:
+        settings = dict(db.execute("SELECT name, settings FROM plannerConfigs"))
+        runs = db.execute(
+            "SELECT plannerConfigs.name, graph_states, iterations FROM runs "
+            "JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id ORDER BY runs.id"
+        ).fetchall()
+    assert "max_tree_size_ratio = 0.5" in settings["geometric_ratio_0.5"]
+    assert "max_tree_size_ratio = 1" in settings["geometric_ratio_1"]  # the two configurations differ
+    assert "ball_radius_constant" in settings["geometric_BallRadiusRRTstar"]
+    for name in ("ratio_0.5", "ratio_1", "BallRadiusRRTstar"):
+        logged = [(states, iterations) for planner, states, iterations in runs if planner == f"geometric_{name}"]
+        assert logged == graphs[name]  # graph states: the trees' sizes the planner counted itself
+        assert all(states > 0 for states, _ in logged)
+    stock_runs = [states for planner, states, _ in runs if planner == "geometric_RRTConnect"]
+    assert len(stock_runs) == RUNS and all(states > 0 for states in stock_runs)  # Benchmark's own reading
