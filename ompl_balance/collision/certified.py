@@ -87,7 +87,7 @@ from .advancement import (
 )
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
-from .kernels import CertifiedMotions, certified_motion_free, robot_states
+from .kernels import CertifiedMotions, certified_edge_free, robot_states
 from .travel import travel_weights
 
 #: Travel (m) to which ``check(..., last_valid=True)`` refines the edge around its first
@@ -153,7 +153,9 @@ class MotionCertifier:
         self._advance = entry_point(
             advance, (lower, lower, self._edge, self._memory.bounds, 0, 1, MIN_TRAVEL, True, self._scratch)
         )
-        self._edge_free = entry_point(certified_motion_free, (self._view, lower, lower))
+        self._edge_free = entry_point(
+            certified_edge_free, (self._edge, self._memory, self._scratch, checker.counter.array, 0, lower, lower)
+        )
 
     def _build_model(self) -> Model:
         robot, obstacles = self._robot, self.checker.environment.obstacles
@@ -201,7 +203,7 @@ class MotionCertifier:
         Counts one motion, the configurations evaluated and the distance queries in the
         checker's counter. Non-finite or out-of-bounds ends: not certified, fraction 0.
         Without ``last_valid`` the work stops at the first failure and a rejected edge
-        reports fraction 0 (the compiled engine's kernel, :func:`~ompl_balance.collision.kernels.certified_motion_free`).
+        reports fraction 0 (the compiled engine's kernel, :func:`~ompl_balance.collision.kernels.certified_edge_free`).
         With ``last_valid`` the edge is refined around its first failure to
         :data:`LAST_VALID_TRAVEL` of travel, and ``a + s (b - a)`` is certified for every ``s``
         up to the fraction returned.
@@ -212,7 +214,8 @@ class MotionCertifier:
             self.checker.counter.motions_checked += 1
             return False, 0.0
         if self.checker.prefilter and not last_valid:
-            free = bool(self._edge_free(self._view, a, b))
+            view = self._view
+            free = bool(self._edge_free(view.edge, view.memory, view.scratch, view.counts, view.handle, a, b))
             return free, 1.0 if free else 0.0
         self.checker.counter.motions_checked += 1
         start, end = self._row(self._memory, a), self._row(self._memory, b)

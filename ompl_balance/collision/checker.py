@@ -33,6 +33,7 @@ from ..core.checks import Count, new_counts
 from ..core.compiled_calls import entry_point
 from .environment import Environment
 from .geometry import fcl_transform
+from .kernels import RobotStates, robot_state_free, robot_states
 from .kinematics import RobotModel
 from .screening import Volumes, build_volumes, screen
 
@@ -124,9 +125,10 @@ class CollisionChecker:
         # 30 us state check): the argument types are fixed here, and _screen passes
         # C-contiguous float rows and fresh output arrays. The single-state path (OMPL's
         # isValid) reuses its output arrays.
-        self._one = self._screen_outputs(1)
-        arguments = (np.zeros((1, robot.dof)), robot.chain, self._volumes, *self._one)
+        arguments = (np.zeros((1, robot.dof)), robot.chain, self._volumes, *self._screen_outputs(1))
         self._kernel = entry_point(screen, arguments)  # compiled or loaded now, not in a solve
+        self._view = robot_states(self)
+        self._state_free = entry_point(robot_state_free, (self._view, np.zeros(robot.dof)))
 
     # ------------------------------------------------------------------ public API
 
@@ -157,13 +159,10 @@ class CollisionChecker:
         q = self.robot.as_array(q, finite=False)
         if len(q) != 1:
             raise ValueError(f"is_valid takes one configuration of {self.robot.dof} joint values, got shape {q.shape}")
+        if self.prefilter:  # the compiled engine's own state check (limits, screening, FCL)
+            return bool(self._state_free(self._view, np.ascontiguousarray(q[0])))
         self.counter.states_checked += 1
-        if not self.robot.within_limits(q)[0]:
-            return False
-        if not self.prefilter:
-            return self._free_reference(self.robot.body_poses(q)[0])
-        poses, obstacle_hits, self_hits = self._one
-        return not self._screen(q, self._one)[0] or self.decide(poses[0], obstacle_hits[0], self_hits[0])
+        return bool(self.robot.within_limits(q)[0]) and self._free_reference(self.robot.body_poses(q)[0])
 
     def first_collision(self, q: ArrayLike, order: ArrayLike | None = None, first_chunk: int = 1) -> int:
         """Index of the first configuration in collision, visiting ``q`` (n, dof) in ``order``, or -1.
@@ -258,12 +257,10 @@ class CollisionChecker:
         self.counter.distance_queries += 1
         return float(fcl.distance(first, second, self._distance_request, fcl.DistanceResult()))
 
-    def kernel_view(self) -> Any:
+    def kernel_view(self) -> RobotStates:
         """The checker as compiled code sees it (:class:`~ompl_balance.collision.kernels.RobotStates`):
         its arrays, and the exit to :meth:`decide` for the pairs the screening leaves to FCL."""
-        from .kernels import robot_states
-
-        return robot_states(self)
+        return self._view
 
     # ------------------------------------------------------------------ internals
 

@@ -234,27 +234,35 @@ def _exact(
 
 
 @njit(cache=True)
-def certified_motion_free(view: CertifiedMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
+def certified_edge_free(
+    edge: EdgeModel, memory: EndMemory, scratch: EdgeScratch, counts: np.ndarray, handle: int, a: np.ndarray, b: np.ndarray
+) -> bool:  # pragma: no cover (compiled)
     """:meth:`MotionCertifier.check` of ``a -> b`` (no ``last_valid``): advancement, stopping at
-    the first failure, then FCL on the hard segments. Counts one motion, the configurations
-    evaluated and the distance queries."""
-    view.counts[Count.MOTIONS] += 1
-    memory = view.memory
+    the first failure, then FCL on the hard segments through the exit ``handle``. Counts one
+    motion, the configurations evaluated and the distance queries in ``counts``. (The parts of
+    a :class:`CertifiedMotions` view it needs, so that Python callers pass no more.)"""
+    counts[Count.MOTIONS] += 1
     start, end = memory_row(memory, a), memory_row(memory, b)
     failed, _bad, hard, evaluated, bounded, hard_pair, hard_span = advance(
-        a, b, view.edge, memory.bounds, start, end, view.edge.floor, True, view.scratch
+        a, b, edge, memory.bounds, start, end, edge.floor, True, scratch
     )
-    view.counts[Count.STATES] += evaluated
-    view.counts[Count.DISTANCE_QUERIES] += bounded
+    counts[Count.STATES] += evaluated
+    counts[Count.DISTANCE_QUERIES] += bounded
     if failed:
         return False
     if hard == 0:
         return True
-    view.counts[Count.EXITS] += 1
+    counts[Count.EXITS] += 1
     pairs, spans = hard_pair[:hard], hard_span[:hard]
     with objmode(free="boolean"):
-        free = _exact(view.handle, a, b, pairs, spans, start, end)
+        free = _exact(handle, a, b, pairs, spans, start, end)
     return free
+
+
+@njit(cache=True)
+def certified_motion_free(view: CertifiedMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
+    """The certified motion kernel of a :class:`CertifiedMotions` view (:func:`certified_edge_free`)."""
+    return certified_edge_free(view.edge, view.memory, view.scratch, view.counts, view.handle, a, b)
 
 
 @njit(cache=True)
@@ -335,3 +343,4 @@ def warm_up() -> None:
     scratch = EdgeScratch(np.zeros((0, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), np.zeros((1, 4)))
     certified = CertifiedMotions(states, edge, end_memory(2, 1, 0), scratch, 0, states.counts)
     certified_motion_free(certified, q, q)
+    certified_edge_free(edge, certified.memory, scratch, states.counts, 0, q, q)  # (the Python callers')
