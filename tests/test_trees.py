@@ -150,3 +150,37 @@ def test_state_tree_nearest_uses_the_space_distance():
     index, distance = tree.nearest(query)
     assert index == 2
     assert distance == pytest.approx(2 * np.pi - 6.2)
+
+
+@pytest.mark.parametrize("space_kind", ["reeds_shepp", "dubins"])
+def test_state_tree_answers_as_the_full_scan_with_few_distances_in_a_metric_space(space_kind):
+    """Reeds-Shepp is a metric (the tree bounds distances through pivots); Dubins is not (it scans)."""
+    space = ob.ReedsSheppStateSpace(0.3) if space_kind == "reeds_shepp" else ob.DubinsStateSpace(0.3)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0.0)
+    bounds.setHigh(10.0)
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda state: True)
+    si.setup()
+    sampler = si.allocStateSampler()
+    tree = StateTree(si)
+    for _ in range(600):
+        state = si.allocState()
+        sampler.sampleUniform(state)
+        tree.add(state)
+    calls = []
+    exact = si.distance
+    tree._distance = lambda a, b: calls.append(1) or exact(a, b)  # count the calls into OMPL
+    query = si.allocState()
+    for _ in range(30):
+        sampler.sampleUniform(query)
+        full = [exact(node, query) for node in tree.states]
+        calls.clear()
+        index, distance = tree.nearest(query)
+        assert (index, distance) == (int(np.argmin(full)), min(full))
+        if space_kind == "reeds_shepp":
+            assert len(calls) < len(full) / 3
+        near, distances = tree.near(query, 2.0)
+        assert near.tolist() == [i for i, d in enumerate(full) if d <= 2.0]
+        np.testing.assert_array_equal(distances, [d for d in full if d <= 2.0])

@@ -235,7 +235,13 @@ def _exact(
 
 @njit(cache=True)
 def certified_edge_free(
-    edge: EdgeModel, memory: EndMemory, scratch: EdgeScratch, counts: np.ndarray, handle: int, a: np.ndarray, b: np.ndarray
+    edge: EdgeModel,
+    memory: EndMemory,
+    scratch: EdgeScratch,
+    counts: np.ndarray,
+    handle: int,
+    a: np.ndarray,
+    b: np.ndarray,
 ) -> bool:  # pragma: no cover (compiled)
     """:meth:`MotionCertifier.check` of ``a -> b`` (no ``last_valid``): advancement, stopping at
     the first failure, then FCL on the hard segments through the exit ``handle``. Counts one

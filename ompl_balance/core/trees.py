@@ -303,8 +303,22 @@ class ArrayTree(_Links):
         self._states[: len(kept)] = self._states[kept]
 
 
+#: Pivots whose distances to every node a :class:`StateTree` in a metric space keeps.
+PIVOTS = 8
+#: Trees with fewer nodes are scanned whole.
+PIVOTED_FROM = 64
+
+
 class StateTree(_Links):
-    """OMPL states of one tree, for any state space; nearest by ``si.distance``."""
+    """OMPL states of one tree, for any state space; nearest by ``si.distance``.
+
+    In a metric space (``space.isMetricSpace()``) the tree keeps each node's distance to a few
+    *pivots* (its first :data:`PIVOTS` nodes), so that by the triangle inequality
+    ``|d(q, p) - d(x, p)|`` bounds ``d(q, x)`` from below for every node ``x`` at once, in numpy;
+    a query computes exact distances (one call into OMPL each) only for nodes in the order of
+    those bounds, until the next bound exceeds the best distance found. The answers are the
+    full scan's (the first node among equally near ones). In other spaces every query scans.
+    """
 
     def __init__(self, si: ob.SpaceInformation, capacity: int = 1024) -> None:
         super().__init__(capacity)
@@ -312,6 +326,8 @@ class StateTree(_Links):
         self._alloc = si.allocState
         self._copy = si.copyState
         self._states: list[ob.State] = []
+        self._metric = bool(si.getStateSpace().isMetricSpace())
+        self._to_pivots = np.zeros((capacity, PIVOTS))  # node x pivot distances
 
     @property
     def states(self) -> list[ob.State]:
@@ -325,13 +341,37 @@ class StateTree(_Links):
         copy = self._alloc()
         self._copy(copy, state)
         self._states.append(copy)
-        return self._link(parent)
+        index = self._link(parent)
+        if self._metric:
+            self._measure(index)
+        return index
+
+    def _measure(self, index: int) -> None:
+        """Node ``index``'s distances to the pivots (and, for a pivot, the earlier nodes' to it)."""
+        if index == len(self._to_pivots):
+            self._to_pivots = np.concatenate([self._to_pivots, np.zeros_like(self._to_pivots)])
+        state, pivots = self._states[index], self._states[:PIVOTS]
+        self._to_pivots[index, : len(pivots)] = [self._distance(state, pivot) for pivot in pivots]
+        if index < PIVOTS:
+            self._to_pivots[:index, index] = [self._distance(node, state) for node in self._states[:index]]
 
     def nearest(self, state: ob.State) -> tuple[int, float]:
+        """Index of the node closest to ``state`` (the first on ties) and its distance."""
+        size = len(self._states)
+        if not self._metric or size < PIVOTED_FROM:
+            distances = self.distances(state)
+            index = int(np.argmin(distances))
+            return index, float(distances[index])
         distance = self._distance
-        distances = [distance(node, state) for node in self._states]
-        index = int(np.argmin(distances))
-        return index, distances[index]
+        bounds = self._lower_bounds(state)
+        best, best_distance = -1, math.inf
+        for node in np.argsort(bounds, kind="stable").tolist():
+            if bounds[node] > best_distance * (1.0 + 1e-12) + 1e-300:
+                break  # every node left is farther than the best (beyond the bounds' rounding)
+            d = distance(self._states[node], state)
+            if d < best_distance or (d == best_distance and node < best):
+                best, best_distance = node, d
+        return best, best_distance
 
     def distances(self, state: ob.State) -> np.ndarray:
         """``si.distance`` from every node to ``state``, ``(len(tree),)``."""
@@ -340,12 +380,26 @@ class StateTree(_Links):
 
     def near(self, state: ob.State, radius: float) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the nodes within ``radius`` of ``state`` (exact, ascending) and their distances."""
-        distances = self.distances(state)
-        within = np.flatnonzero(distances <= radius)
-        return within, distances[within]
+        if not self._metric or len(self._states) < PIVOTED_FROM:
+            distances = self.distances(state)
+            within = np.flatnonzero(distances <= radius)
+            return within, distances[within]
+        candidates = np.flatnonzero(self._lower_bounds(state) <= radius * (1.0 + 1e-12) + 1e-300)
+        distances = np.array([self._distance(self._states[node], state) for node in candidates.tolist()], dtype=float)
+        keep = distances <= radius
+        return candidates[keep], distances[keep]
+
+    def _lower_bounds(self, state: ob.State) -> np.ndarray:
+        """``max_p |d(state, p) - d(x, p)|`` for every node ``x``: each a lower bound of ``d(state, x)``."""
+        size = len(self._states)
+        to_query = np.array([self._distance(state, pivot) for pivot in self._states[:PIVOTS]])
+        return np.abs(self._to_pivots[:size, : len(to_query)] - to_query).max(axis=1)
 
     def _keep_states(self, kept: np.ndarray) -> None:
         self._states = [self._states[index] for index in kept.tolist()]
+        if self._metric:  # the pivots may be gone: measure again
+            for index in range(len(self._states)):
+                self._measure(index)
 
     def clear(self) -> None:
         super().clear()
