@@ -33,7 +33,7 @@ from ..core.checks import Count, new_counts
 from ..core.compiled_calls import entry_point
 from .environment import Environment
 from .geometry import fcl_transform
-from .kernels import RobotStates, robot_state_free, robot_states
+from .kernels import RobotStates, robot_state_free, robot_states, warm_exits_once
 from .kinematics import RobotModel
 from .screening import Volumes, build_volumes, screen
 
@@ -129,6 +129,7 @@ class CollisionChecker:
         self._kernel = entry_point(screen, arguments)  # compiled or loaded now, not in a solve
         self._view = robot_states(self)
         self._state_free = entry_point(robot_state_free, (self._view, np.zeros(robot.dof)))
+        warm_exits_once()  # the first FCL query of a process would pay it inside a solve
 
     # ------------------------------------------------------------------ public API
 

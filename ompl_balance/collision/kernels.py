@@ -259,7 +259,14 @@ def certified_edge_free(
     if hard == 0:
         return True
     counts[Count.EXITS] += 1
-    pairs, spans = hard_pair[:hard], hard_span[:hard]
+    return hard_segments_free(handle, a, b, hard_pair[:hard], hard_span[:hard], start, end)
+
+
+@njit(cache=True)
+def hard_segments_free(
+    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int
+) -> bool:  # pragma: no cover (compiled)
+    """The exit to the certifier behind ``handle``: FCL on the hard segments of ``a -> b``."""
     with objmode(free="boolean"):
         free = _exact(handle, a, b, pairs, spans, start, end)
     return free
@@ -282,6 +289,25 @@ register_kernels(RobotDiscreteMotions, state=_states_of_free, motion=robot_discr
 register_kernels(CertifiedMotions, state=_states_of_free, motion=certified_motion_free)
 
 
+def warm_stand_ins() -> tuple[Chain, Volumes, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The arrays of a :class:`RobotStates` view of a one-joint robot without geometry, but its
+    exit handle and counts: arguments of the types every robot passes."""
+    from .screening import stand_ins
+
+    chain, volumes = stand_ins()
+    q = np.zeros(1)
+    return (
+        chain,
+        volumes,
+        q,
+        q,
+        np.zeros((1, 1)),
+        np.zeros((1, 2, 4, 4)),
+        np.zeros((1, 0, 0), dtype=np.bool_),
+        np.zeros((1, 0), dtype=np.bool_),
+    )
+
+
 def warm_up() -> None:
     """Compile the kernels of the three views, or load them from numba's cache, for the argument
     types every robot passes (a one-joint robot without geometry stands in), as
@@ -294,18 +320,7 @@ def warm_up() -> None:
 
     chain, volumes = stand_ins()
     q = np.zeros(1)
-    states = RobotStates(
-        chain,
-        volumes,
-        q,
-        q,
-        np.zeros((1, 1)),
-        np.zeros((1, 2, 4, 4)),
-        np.zeros((1, 0, 0), dtype=np.bool_),
-        np.zeros((1, 0), dtype=np.bool_),
-        0,
-        new_counts(),
-    )
+    states = RobotStates(*warm_stand_ins(), 0, new_counts())
     robot_state_free(states, q)
     one = np.ones(1)
     layout = SpaceLayout(
@@ -350,3 +365,40 @@ def warm_up() -> None:
     certified = CertifiedMotions(states, edge, end_memory(2, 1, 0), scratch, 0, states.counts)
     certified_motion_free(certified, q, q)
     certified_edge_free(edge, certified.memory, scratch, states.counts, 0, q, q)  # (the Python callers')
+    warm_exits_once()
+
+
+class _AllFree:
+    """An exit target answering every query "free" (for :func:`warm_exits`)."""
+
+    def decide(self, *arguments: Any) -> bool:
+        return True
+
+    def hard_segments_free(self, *arguments: Any) -> bool:
+        return True
+
+
+_EXITS_WARM = [False]
+
+
+def warm_exits_once() -> None:
+    """:func:`warm_exits`, the first time a process calls this."""
+    if not _EXITS_WARM[0]:
+        warm_exits()
+        _EXITS_WARM[0] = True
+
+
+def warm_exits() -> None:
+    """Run each exit to Python once: numba makes a kernel's ``objmode`` code ready the first
+    time it runs in a process (about a tenth of a second), which would otherwise fall on the
+    first FCL query of a solve."""
+    target = _AllFree()
+    handle = exit_handle(target)
+    q = np.zeros(1)
+    decide_screened(
+        RobotStates(*warm_stand_ins(), handle, np.zeros(len(Count), dtype=np.int64)),
+        np.zeros((2, 4, 4)),
+        np.zeros((0, 0), dtype=np.bool_),
+        np.zeros(0, dtype=np.bool_),
+    )
+    hard_segments_free(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)), 0, 1)

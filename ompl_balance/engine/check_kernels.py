@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit, objmode
 
 from ..core.check_overloads import register_kernels
-from ..core.checks import Count, state_free
+from ..core.checks import Count, exit_handle, new_counts, state_free
 from ..core.compiled_spaces import interpolate, segment_count
 from .views import DiscreteMotions, PythonChecks, call_check_motion, call_is_valid
 
@@ -66,3 +66,23 @@ def _discrete_state_free(view: DiscreteMotions, q: np.ndarray) -> bool:  # pragm
 
 register_kernels(DiscreteMotions, state=_discrete_state_free, motion=_discrete_motion_free)
 register_kernels(PythonChecks, state=_python_state_free, motion=_python_motion_free)
+
+
+class _AllFree:
+    """An exit target answering every query "free" (for :func:`warm_exits`)."""
+
+    def is_valid(self, q: np.ndarray) -> bool:
+        return True
+
+    def check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
+        return True
+
+
+def warm_exits() -> None:
+    """Run the exits to Python once: numba makes a kernel's ``objmode`` code ready the first time
+    it runs in a process (about a tenth of a second), which would otherwise fall in a solve."""
+    target = _AllFree()
+    view = PythonChecks(exit_handle(target), new_counts())
+    q = np.zeros(1)
+    _python_state_free(view, q)
+    _python_motion_free(view, q, q)

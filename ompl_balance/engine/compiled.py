@@ -62,11 +62,14 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
             )
     except (OSError, subprocess.SubprocessError, pickle.PicklingError):
         pass  # compiled here instead
-    for module in kernel_modules(view):
-        importlib.import_module(module)
+    modules = [importlib.import_module(module) for module in kernel_modules(view)]
     from .driver import warm_up
 
     warm_up(view, layout)
+    for module in modules:  # the exits to Python, run once (see their warm_exits)
+        warm_exits = getattr(module, "warm_exits", None)
+        if warm_exits is not None:
+            warm_exits()
 
 
 def load(si: ob.SpaceInformation, layout: SpaceLayout, wait: bool) -> None:
