@@ -208,6 +208,14 @@ def estimate_free_measure(
     )
 
 
+def beta_quantile_function() -> Callable[..., Any]:
+    """scipy's ``betaincinv``, imported on first use (a quarter of a second, more under load):
+    planners that estimate ``gamma`` call this when they are made, so no solve pays it."""
+    from scipy.special import betaincinv
+
+    return betaincinv
+
+
 def clopper_pearson(successes: int, trials: int, confidence: float) -> tuple[float, float]:
     """The Clopper-Pearson ("exact") interval of a binomial proportion at level ``confidence``.
 
@@ -215,8 +223,7 @@ def clopper_pearson(successes: int, trials: int, confidence: float) -> tuple[flo
     ``B(1 - a/2; k + 1, n - k)``, ``a = 1 - confidence`` (0 and 1 when ``k`` is 0 or ``n``);
     scipy's ``binomtest(...).proportion_ci(method="exact")`` finds the same ends by root finding.
     """
-    from scipy.special import betaincinv  # imported here, on first use: a quarter of a second
-
+    betaincinv = beta_quantile_function()
     alpha = (1.0 - confidence) / 2.0
     low = 0.0 if successes == 0 else float(betaincinv(successes, trials - successes + 1, alpha))
     high = 1.0 if successes == trials else float(betaincinv(successes + 1, trials - successes, 1.0 - alpha))

@@ -23,7 +23,7 @@ from .core.params import Settings, param
 from .core.planner import RANGE_AS_EXTENT_FRACTION, PlannerSpecs, TreePlanner
 from .core.spaces import Points
 from .core.trees import NO_PARENT, Tree
-from .gamma import EstimateInterruptedError, estimate_ball_radius_constant, rewire_radius
+from .gamma import EstimateInterruptedError, beta_quantile_function, estimate_ball_radius_constant, rewire_radius
 
 #: Monte Carlo samples used to estimate the free measure when ``ball_radius_constant`` is ``auto``.
 AUTO_GAMMA_SAMPLES = 5000
@@ -282,6 +282,7 @@ class BallRadiusRRTstar(TreePlanner):
         self._estimated_gamma: float | None = None
         self._tree: CostTree | None = None
         self._pruned_cost = math.inf  # the best cost at the last pruning
+        beta_quantile_function()  # the estimate's interval needs scipy: loaded now, not in a solve
 
     def getBallRadiusConstantInUse(self) -> float:  # noqa: N802
         """The ``gamma`` the next solve uses: in ``auto`` mode the estimate, made now if no

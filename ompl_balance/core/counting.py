@@ -53,6 +53,7 @@ class CountingValidityChecker(ob.StateValidityChecker):
         self._check = check.isValid if isinstance(check, ob.StateValidityChecker) else check
         self.states_checked = 0  # by isValid; compiled code counts in self._compiled_counts
         self._compiled_counts = new_counts()
+        self._view: Any = None
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         self.states_checked += 1
@@ -60,8 +61,10 @@ class CountingValidityChecker(ob.StateValidityChecker):
 
     def compiled_view(self) -> Any:
         """The wrapped callable's compiled view (:mod:`ompl_balance.core.checks`), or ``None``."""
-        view_of = getattr(self._check, "compiled_view", None)
-        return None if view_of is None else view_of(self._compiled_counts)
+        if self._view is None:
+            view_of = getattr(self._check, "compiled_view", None)
+            self._view = False if view_of is None else view_of(self._compiled_counts)
+        return self._view or None
 
     def counters(self) -> dict[str, int]:
         """States decided since construction or the last reset (by ``isValid`` and by compiled

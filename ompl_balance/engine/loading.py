@@ -27,11 +27,30 @@ QUIET_WAIT = 1.0
 
 def view_key(value: Any) -> Any:
     """What numba compiles a specialization of the engine for, as a hashable key: the classes of
-    named tuples with the keys of their fields, arrays by dtype, dimensions and layout, scalars by type."""
-    if isinstance(value, tuple) and hasattr(value, "_fields"):
-        return (type(value), tuple(view_key(field) for field in value))
+    named tuples with the keys of their fields, arrays by dtype, dimensions and layout, scalars by type.
+
+    The keys of the last views asked about are remembered (a solve asks about the same views again).
+    """
     if isinstance(value, tuple):
-        return tuple(view_key(item) for item in value)
+        known = _KEYS.get(id(value))
+        if known is not None and known[0] is value:
+            return known[1]
+        key = _view_key(value)
+        if len(_KEYS) >= 64:
+            _KEYS.pop(next(iter(_KEYS)))
+        _KEYS[id(value)] = (value, key)
+        return key
+    return _view_key(value)
+
+
+_KEYS: dict[int, tuple[Any, Any]] = {}  # id -> (the value, its key), the value kept so its id is not reused
+
+
+def _view_key(value: Any) -> Any:
+    if isinstance(value, tuple) and hasattr(value, "_fields"):
+        return (type(value), tuple(_view_key(field) for field in value))
+    if isinstance(value, tuple):
+        return tuple(_view_key(item) for item in value)
     if isinstance(value, np.ndarray):
         return (value.dtype.str, value.ndim, value.flags.c_contiguous, value.flags.writeable)
     return type(value)
