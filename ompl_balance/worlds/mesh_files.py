@@ -20,6 +20,7 @@ without normals or texture coordinates).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -113,6 +114,12 @@ def _face_normals(triangles: np.ndarray) -> np.ndarray:
 
 
 def _read_collada(path: Path) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    with warnings.catch_warnings():  # pycollada builds numpy matrices, which numpy warns about
+        warnings.simplefilter("ignore", PendingDeprecationWarning)
+        return _collada_meshes(path)
+
+
+def _collada_meshes(path: Path) -> tuple[list[np.ndarray], list[np.ndarray]]:
     import collada
 
     document = collada.Collada(str(path), ignore=[collada.common.DaeUnsupportedError, collada.common.DaeBrokenRefError])

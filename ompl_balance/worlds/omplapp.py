@@ -130,14 +130,15 @@ def axis_angle_quaternion(axis: tuple[float, float, float], angle: float) -> np.
     return np.array([axis[0] * s, axis[1] * s, axis[2] * s, math.cos(0.5 * angle)])
 
 
-def load_omplapp(cfg_path: str | Path) -> RigidBodyProblem:
+def load_omplapp(cfg_path: str | Path, validate: bool = True) -> RigidBodyProblem:
     """The geometric problem of an OMPL.app ``.cfg`` file (see the module docstring).
 
     ``ValueError`` naming the file (and line) for: a missing or unreadable file, a malformed
     line, a missing or non-numeric entry, a missing or unreadable mesh, a mesh without
-    triangles or only degenerate ones, inconsistent bounds, a start or goal in collision or
-    outside the bounds, and control-based problems (``control = ...``) or other state spaces
-    (``statespace = dubins``, ...), which the loader does not plan for.
+    triangles or only degenerate ones, inconsistent bounds, control-based problems
+    (``control = ...``) or other state spaces (``statespace = dubins``, ...), which the loader
+    does not plan for, and (``validate``, the default) a start or goal in collision. With
+    ``validate=False`` such a problem loads, and OMPL's planners report it when they solve.
     """
     path = Path(cfg_path)
     if not path.is_file():
@@ -197,7 +198,7 @@ def load_omplapp(cfg_path: str | Path) -> RigidBodyProblem:
         source=path,
     )
     checker = problem.checker()
-    for side, state in (("start", start), ("goal", goal)):
+    for side, state in (("start", start), ("goal", goal)) if validate else ():
         key = f"problem.{side}.x"
         if not checker.inside_bounds(state):
             raise ValueError(f"{config.at(key)}: the {side} state {state.tolist()} is outside the bounds")
@@ -248,15 +249,16 @@ def _bounds(config: _Config, world: MeshFile, axes: int) -> tuple[np.ndarray, np
 
 def read_omplapp_path(path: str | Path, space: str | None = None) -> np.ndarray:
     """The states of an OMPL.app ``.path`` file (one state per line: ``x y yaw`` or
-    ``x y z qx qy qz qw``) as an array (n, 3) or (n, 7). ``space`` (``"SE2"``/``"SE3"``), if given,
-    must match the file. ``ValueError`` naming the file and line for anything else."""
+    ``x y z qx qy qz qw``) as an array (n, 3) or (n, 7), quaternions normalised (files print
+    them to a few digits). ``space`` (``"SE2"``/``"SE3"``), if given, must match the file.
+    ``ValueError`` naming the file and line for anything else."""
     path = Path(path)
     try:
         text = path.read_text()
     except (OSError, UnicodeDecodeError) as error:
         raise ValueError(f"cannot read OMPL.app path file {path}: {error}") from error
     size = {"SE2": 3, "SE3": 7}.get(space or "", 0)
-    rows = []
+    rows, lines = [], []
     for number, raw in enumerate(text.splitlines(), start=1):
         if not raw.strip():
             continue
@@ -269,6 +271,14 @@ def read_omplapp_path(path: str | Path, space: str | None = None) -> np.ndarray:
             expected = f"{size} numbers" if size in (3, 7) else "3 (SE(2)) or 7 (SE(3)) numbers"
             raise ValueError(f"{path}:{number}: expected {expected} per state, got {raw.strip()!r}")
         rows.append(values)
+        lines.append(number)
     if not rows:
         raise ValueError(f"{path} holds no states")
-    return np.array(rows)
+    states = np.array(rows)
+    if size == 7:  # files print a few digits: the quaternions are unit to that precision
+        norms = np.linalg.norm(states[:, 3:], axis=1)
+        far = np.flatnonzero(np.abs(norms - 1.0) > 1e-3)
+        if len(far):
+            raise ValueError(f"{path}:{lines[far[0]]}: the quaternion has norm {norms[far[0]]:.6g}, not 1")
+        states[:, 3:] /= norms[:, None]
+    return states

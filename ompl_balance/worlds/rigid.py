@@ -15,9 +15,9 @@ certified (default) or discrete motions. Problems come from OMPL.app's problem f
 ``se3_cage``
     An L-shaped robot starts inside a closed cage with one narrow window: one tree is trapped.
 ``se3_room``
-    An L-shaped robot crosses a room cluttered with furniture, from floor to ceiling.
+    An L-shaped robot crosses a cluttered room through a hatch or a window in a partition.
 ``se3_maze``
-    A three-armed "jack" finds its way through a two-storey maze and up through a hole.
+    A six-armed "jack" winds through a two-storey maze, turning to pass a hole in the floor.
 
 The robots are triangle meshes the package writes itself (:func:`write_robot_meshes`, files in
 ``ompl_balance/data/rigid/``), one convex box per part; obstacles are boxes. Lengths in metres.
@@ -118,9 +118,9 @@ ROBOTS: dict[str, tuple[str, tuple[tuple[str, tuple[float, ...], tuple[float, ..
     "jack": (
         "SE3",
         (
-            ("x", (0.0, 0.0, 0.0), (0.5, 0.06, 0.06)),
-            ("y", (0.0, 0.0, 0.0), (0.06, 0.5, 0.06)),
-            ("z", (0.0, 0.0, 0.0), (0.06, 0.06, 0.5)),
+            ("x", (0.0, 0.0, 0.0), (0.7, 0.08, 0.08)),
+            ("y", (0.0, 0.0, 0.0), (0.08, 0.7, 0.08)),
+            ("z", (0.0, 0.0, 0.0), (0.08, 0.08, 0.7)),
         ),
     ),
 }
@@ -231,10 +231,10 @@ def _se3_slot() -> RigidBodyProblem:
     _add_boxes(
         environment,
         [
-            ("wall_top", (-0.05, -2.0, 0.15), (0.05, 2.0, 2.0)),
-            ("wall_bottom", (-0.05, -2.0, -2.0), (0.05, 2.0, -0.15)),
-            ("wall_left", (-0.05, -2.0, -0.15), (0.05, -0.6, 0.15)),
-            ("wall_right", (-0.05, 0.6, -0.15), (0.05, 2.0, 0.15)),
+            ("wall_top", (-0.05, -2.0, 0.2), (0.05, 2.0, 2.0)),
+            ("wall_bottom", (-0.05, -2.0, -2.0), (0.05, 2.0, -0.2)),
+            ("wall_left", (-0.05, -2.0, -0.2), (0.05, -0.6, 0.2)),
+            ("wall_right", (-0.05, 0.6, -0.2), (0.05, 2.0, 0.2)),
         ],
     )
     standing = _quaternion((1.0, 0.0, 0.0), math.pi / 2)
@@ -264,53 +264,74 @@ def _se3_cage() -> RigidBodyProblem:
     )  # fmt: skip
 
 
-#: The furniture of ``se3_room``: (name, low corner, high corner), metres.
-ROOM_FURNITURE = (
-    ("table", (1.0, 1.0, 0.7), (2.2, 1.8, 0.8)),
-    ("table_leg_a", (1.05, 1.05, 0.0), (1.15, 1.15, 0.7)),
-    ("table_leg_b", (2.05, 1.65, 0.0), (2.15, 1.75, 0.7)),
-    ("pillar_a", (2.8, 0.4, 0.0), (3.2, 0.8, 3.0)),
-    ("pillar_b", (1.6, 3.0, 0.0), (2.0, 3.4, 3.0)),
-    ("pillar_c", (3.8, 2.6, 0.0), (4.2, 3.0, 3.0)),
-    ("shelf", (0.0, 2.2, 0.0), (0.5, 3.8, 2.2)),
-    ("shelf_top", (0.0, 2.2, 2.2), (1.2, 3.8, 2.3)),
-    ("cabinet", (4.3, 0.0, 0.0), (5.0, 1.4, 1.2)),
-    ("beam_x", (0.0, 2.45, 1.6), (5.0, 2.65, 1.8)),
-    ("beam_y", (2.95, 0.0, 2.0), (3.15, 5.0, 2.2)),
-    ("lamp", (2.3, 2.3, 2.4), (2.7, 2.7, 3.0)),
-    ("sofa", (3.3, 4.0, 0.0), (5.0, 5.0, 0.9)),
-    ("crate_a", (1.0, 4.0, 0.0), (1.6, 4.6, 0.6)),
-    ("crate_b", (1.1, 4.1, 0.6), (1.5, 4.5, 1.0)),
-    ("screen", (2.4, 3.8, 0.0), (2.5, 5.0, 2.0)),
+#: The clutter of ``se3_room``: (name, low corner, high corner), metres.
+ROOM_CLUTTER = (
+    ("clutter_00", (0.0, 0.46, 2.26), (0.29, 1.01, 3.0)),
+    ("clutter_01", (3.61, 3.16, 1.34), (4.27, 3.55, 1.73)),
+    ("clutter_02", (0.64, 2.48, 0.66), (1.41, 3.06, 2.24)),
+    ("clutter_03", (3.79, 4.03, 0.12), (4.23, 4.64, 0.65)),
+    ("clutter_04", (4.22, 1.95, 0.28), (4.74, 2.35, 0.6)),
+    ("clutter_05", (0.75, 0.0, 0.0), (1.42, 0.34, 1.46)),
+    ("clutter_06", (3.27, 1.43, 0.0), (3.71, 1.96, 1.47)),
+    ("clutter_07", (3.3, 0.0, 0.0), (3.61, 0.9, 0.84)),
+    ("clutter_08", (1.19, 0.14, 0.2), (1.98, 0.75, 0.83)),
+    ("clutter_09", (3.5, 2.36, 2.25), (3.77, 2.57, 2.86)),
+    ("clutter_10", (4.72, 4.49, 0.74), (5.0, 4.92, 1.3)),
+    ("clutter_11", (0.0, 0.13, 0.59), (0.51, 0.55, 1.83)),
+    ("clutter_12", (0.0, 1.38, 0.0), (0.75, 2.21, 1.26)),
+    ("clutter_13", (0.07, 2.9, 0.25), (0.72, 3.21, 1.14)),
+    ("clutter_14", (3.07, 1.48, 1.44), (3.3, 1.76, 2.42)),
+    ("clutter_15", (4.41, 3.2, 0.0), (4.67, 3.8, 1.55)),
+    ("clutter_16", (0.98, 3.57, 0.12), (1.69, 4.33, 1.38)),
+    ("clutter_17", (1.28, 2.79, 1.36), (1.58, 3.27, 2.26)),
+    ("clutter_18", (3.49, 1.13, 2.05), (3.86, 1.77, 2.75)),
+    ("clutter_19", (0.01, 0.56, 1.91), (0.28, 0.99, 2.88)),
+    ("clutter_20", (3.4, 1.17, 1.2), (4.15, 1.82, 2.67)),
+    ("clutter_21", (0.55, 4.02, 1.7), (0.99, 4.74, 2.44)),
 )
 
 
 def _se3_room() -> RigidBodyProblem:
+    """A 5 x 5 x 3 m room cut in two by a wall with a low hatch and a window (0.5 x 0.5 m each),
+    boxes strewn on both sides; from the floor of one half to the ceiling of the other."""
     environment = Environment()
-    _add_boxes(environment, [*_shell((0.0, 0.0, 0.0), (5.0, 5.0, 3.0)), *ROOM_FURNITURE])
+    x0, x1 = 2.45, 2.55
+    partition = [
+        ("partition_a", (x0, 0.0, 0.0), (x1, 0.8, 3.0)),
+        ("partition_b", (x0, 1.3, 0.0), (x1, 3.6, 3.0)),
+        ("partition_c", (x0, 4.1, 0.0), (x1, 5.0, 3.0)),
+        ("over_door", (x0, 0.8, 0.5), (x1, 1.3, 3.0)),
+        ("under_window", (x0, 3.6, 0.0), (x1, 4.1, 1.8)),
+        ("over_window", (x0, 3.6, 2.3), (x1, 4.1, 3.0)),
+    ]
+    _add_boxes(environment, [*_shell((0.0, 0.0, 0.0), (5.0, 5.0, 3.0)), *partition, *ROOM_CLUTTER])
     return RigidBodyProblem(
-        "se3_room", shipped_robot("ell"), environment, np.array([0.5, 0.5, 0.4, 0.0, 0.0, 0.0, 1.0]),
-        np.array([4.5, 4.3, 2.6, *_quaternion((0.0, 0.0, 1.0), math.pi / 2)]), np.array([0.2, 0.2, 0.2]),
+        "se3_room", shipped_robot("ell"), environment, np.array([0.5, 4.5, 0.5, 0.0, 0.0, 0.0, 1.0]),
+        np.array([4.5, 0.5, 2.5, *_quaternion((0.0, 0.0, 1.0), math.pi / 2)]), np.full(3, 0.2),
         np.array([4.8, 4.8, 2.8]), time_limit=20.0,
     )  # fmt: skip
 
 
 def _maze_walls() -> list:
-    """Walls of ``se3_maze``: two storeys of 3 x 3 cells (1 m), a floor between them with a hole
-    above cell (2, 0); the way winds through every cell of both storeys."""
+    """Walls of ``se3_maze``: two storeys of 4 x 4 cells (1 m), each a serpentine, joined by a
+    0.7 m square hole in the floor above the ground storey's last cell."""
     t = 0.05  # half thickness
     walls = [
-        # ground storey: x = 1 for y in [0, 2], x = 2 for y in [1, 3]
-        ("ground_x1", (1 - t, 0.0, 0.0), (1 + t, 2.0, 1.0)),
-        ("ground_x2", (2 - t, 1.0, 0.0), (2 + t, 3.0, 1.0)),
-        # upper storey: y = 1 for x in [1, 3], y = 2 for x in [0, 2]
-        ("upper_y1", (1.0, 1 - t, 1.0), (3.0, 1 + t, 2.0)),
-        ("upper_y2", (0.0, 2 - t, 1.0), (2.0, 2 + t, 2.0)),
-        # the floor between the storeys, with a 0.8 m hole above cell (2, 0)
-        ("floor_a", (0.0, 0.0, 1 - t), (2.1, 3.0, 1 + t)),
-        ("floor_b", (2.1, 0.9, 1 - t), (3.0, 3.0, 1 + t)),
+        # ground storey: rows joined at alternate ends (walls along x at y = 1, 2, 3)
+        ("ground_1", (0.0, 1 - t, 0.0), (3.0, 1 + t, 1.0)),
+        ("ground_2", (1.0, 2 - t, 0.0), (4.0, 2 + t, 1.0)),
+        ("ground_3", (0.0, 3 - t, 0.0), (3.0, 3 + t, 1.0)),
+        # upper storey: columns joined at alternate ends (walls along y at x = 1, 2, 3)
+        ("upper_1", (1 - t, 1.0, 1.0), (1 + t, 4.0, 2.0)),
+        ("upper_2", (2 - t, 0.0, 1.0), (2 + t, 3.0, 2.0)),
+        ("upper_3", (3 - t, 1.0, 1.0), (3 + t, 4.0, 2.0)),
+        # the floor between the storeys, a hole at x in [0.15, 0.85], y in [3.15, 3.85]
+        ("floor_west", (0.0, 0.0, 1 - t), (0.15, 4.0, 1 + t)),
+        ("floor_east", (0.85, 0.0, 1 - t), (4.0, 4.0, 1 + t)),
+        ("floor_south", (0.15, 0.0, 1 - t), (0.85, 3.15, 1 + t)),
+        ("floor_north", (0.15, 3.85, 1 - t), (0.85, 4.0, 1 + t)),
     ]
-    return [*_shell((0.0, 0.0, 0.0), (3.0, 3.0, 2.0)), *walls]
+    return [*_shell((0.0, 0.0, 0.0), (4.0, 4.0, 2.0)), *walls]
 
 
 def _se3_maze() -> RigidBodyProblem:
@@ -318,7 +339,7 @@ def _se3_maze() -> RigidBodyProblem:
     _add_boxes(environment, _maze_walls())
     return RigidBodyProblem(
         "se3_maze", shipped_robot("jack"), environment, np.array([0.5, 0.5, 0.5, 0.0, 0.0, 0.0, 1.0]),
-        np.array([0.5, 2.5, 1.5, 0.0, 0.0, 0.0, 1.0]), np.zeros(3), np.array([3.0, 3.0, 2.0]), time_limit=30.0,
+        np.array([3.5, 3.5, 1.5, 0.0, 0.0, 0.0, 1.0]), np.zeros(3), np.array([4.0, 4.0, 2.0]), time_limit=60.0,
     )  # fmt: skip
 
 

@@ -240,7 +240,7 @@ def _placed(pose: np.ndarray, point: np.ndarray) -> tuple[float, float, float]: 
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sphere_bound(view: RigidView, pose: np.ndarray, pair: int) -> float:  # pragma: no cover (compiled)
     """Lower bound on ``pair``'s distance with the body at ``pose`` (4, 4), from the part's sphere
     against the obstacle's box and sphere, less :data:`~ompl_balance.collision.screening.SLACK`."""
@@ -297,8 +297,8 @@ def state_status(view: RigidView, state: np.ndarray) -> int:  # pragma: no cover
     Pairs are screened obstacle by obstacle (those the body's sphere reaches), part by part,
     until one is not cleared: the part's sphere against the obstacle's box and sphere, then
     (``view.fine``) its small spheres against the box and, for convex pairs, GJK. A pair not
-    cleared whose part has a corner strictly inside an FCL box obstacle is a contact
-    (``COLLIDING``). ``UNDECIDED``
+    cleared, or not screened after that, whose part has a corner strictly inside an FCL box
+    obstacle is a contact (``COLLIDING``). ``UNDECIDED``
     leaves the pairs FCL must test in ``view.undecided[:view.counts[0]]``: that pair first (the
     likeliest contact), then every pair not screened yet; the body pose is in ``view.pose[0]``.
     ``view.counts[3]`` counts the GJK bounds computed.
@@ -332,11 +332,14 @@ def state_status(view: RigidView, state: np.ndarray) -> int:  # pragma: no cover
         if gap > body_radius + SLACK:
             continue
         for g in range(parts):
-            if undecided > 0:  # FCL will be needed anyway: the rest goes to it unscreened
+            x, y, z = placed_part[g, 0], placed_part[g, 1], placed_part[g, 2]
+            if undecided > 0:  # FCL will be needed anyway: the rest goes to it unscreened, but
+                # a contact found here spares FCL
+                if solid_box[o] and corners_on_surface[g] and _corner_inside(view, pose, o, g):
+                    return COLLIDING
                 undecided_pairs[undecided] = o * parts + g
                 undecided += 1
                 continue
-            x, y, z = placed_part[g, 0], placed_part[g, 1], placed_part[g, 2]
             gap = max(
                 _box_gap(box_centre, box_axes, box_half, o, x, y, z),
                 math.sqrt((x - around[o, 0]) ** 2 + (y - around[o, 1]) ** 2 + (z - around[o, 2]) ** 2)
