@@ -156,7 +156,7 @@ def test_load_se3_poses_bounds_time_limit(scene):
 
 def test_load_se2_frame_has_z_zero(tmp_path):
     corners, faces = box([-1.0, -1.0, -1.0], [1.0, 3.0, 1.0])  # z_up: becomes y in [-1, 1], z in [-3, 1]
-    collada(tmp_path / "robot.dae", [*corners, 5.0, 0.0, 0.0], faces)
+    collada(tmp_path / "robot.dae", corners + np.array([5.0, 0.0, 0.0]), faces)
     world, world_faces = box([10.0, 10.0, -1.0], [11.0, 11.0, 1.0])
     collada(tmp_path / "world.dae", world, world_faces)
     lines = ["[problem]", "robot = robot.dae", "world = world.dae", "start.x = 0", "start.y = 0", "start.theta = 0.5",

@@ -275,10 +275,14 @@ def test_certified_edges_are_free_convex_parts_among_boxes(space):
     assert checker.counters()["motions_checked"] == 2 * len(edges)
 
 
-def test_certified_edges_are_free_non_convex_meshes():
-    """A non-convex body among tetrahedra: hull bounds, then FCL's exact distances finish."""
+@pytest.mark.parametrize("with_box", [False, True], ids=["meshes", "meshes and a box"])
+def test_certified_edges_are_free_non_convex_meshes(with_box):
+    """A non-convex body among tetrahedra: hull bounds, then FCL's exact distances finish (the
+    whole body against the whole world when both are meshes, pair by pair with a box among them)."""
     rng = np.random.default_rng(7)
     environment, _ = mesh_world(rng)
+    if with_box:
+        environment.add_box("box", (0.3, 0.1, 0.3), (0.2, -0.3, 0.1))
     body = RigidBody.from_triangles("SE3", l_mesh(), pieces=2)
     low, high = np.full(3, -1.2), np.full(3, 1.2)
     checker = RigidBodyChecker(body, environment, (low, high))

@@ -47,7 +47,7 @@ from .rigid import RigidBodyProblem
 #: The robot mesh is cut into at most this many parts.
 ROBOT_PIECES = 8
 #: The world mesh is cut into pieces of about this many triangles ...
-WORLD_PIECE_TRIANGLES = 32
+WORLD_PIECE_TRIANGLES = 64
 #: ... and at most this many pieces.
 WORLD_PIECES = 256
 

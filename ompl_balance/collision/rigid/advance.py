@@ -19,7 +19,8 @@ A pair whose hulls are its FCL models (convex shapes: ``view.solid``) is decided
 upper bound within :data:`~ompl_balance.collision.advancement.DISTANCE_TOLERANCE` (times the
 view's scale) of the clearance is a contact. Segments of other pairs (a non-convex mesh, whose
 hull may touch where the mesh does not) with at most ``view.handover`` of travel still
-uncertified are left to FCL's exact distance in ``view.hard`` (``UNDECIDED``). A segment still
+uncertified, or whose hulls overlap at an end (the hulls cannot certify them), are left to FCL's
+exact distance in ``view.hard`` (``UNDECIDED``). A segment still
 uncertified with less than :data:`MIN_TRAVEL` (times the scale) of travel refuses the motion, so
 the kernel always terminates.
 """
@@ -152,7 +153,9 @@ def edge_status(
                 break
         if seg_d[e, 0] + seg_d[e, 1] > need or t0 >= bad:
             continue
-        if not solid[pair] and travel <= view.handover:
+        # a hull that overlaps at an end will overlap on every piece cut from that end: FCL now
+        overlapping = (seg_final[e, 0] and seg_d[e, 0] <= 0.0) or (seg_final[e, 1] and seg_d[e, 1] <= 0.0)
+        if not solid[pair] and (travel <= view.handover or overlapping):
             if hard < len(view.hard):
                 row = view.hard[hard]
                 row[0], row[1], row[2], row[3], row[4] = pair, t0, t1, seg_d[e, 0], seg_d[e, 1]

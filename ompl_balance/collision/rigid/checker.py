@@ -58,6 +58,8 @@ from .view import (
 )
 
 _REQUEST = fcl.CollisionRequest()
+#: The pair index of the whole body against the whole world (both meshes) in the FCL phase.
+WHOLE = -1
 _DISTANCE_REQUEST = fcl.DistanceRequest()
 
 
@@ -355,14 +357,17 @@ class RigidBodyChecker:
 
         ``bad``/``failed``: what the kernel found (certified on ``[0, bad]`` but for the
         segments). Conservative advancement as the kernel does it, with FCL's exact distances
-        (contact: ``-inf``) as the bounds; returns ``(certified, fraction)``.
+        (contact: ``-inf``) as the bounds; returns ``(certified, fraction)``. When body and world
+        are both meshes, the segments' spans are certified for the whole body against the whole
+        world instead (pair :data:`WHOLE`: one distance per pose bounds every pair, travelling at
+        the body's reach).
         """
         view, counter = self.view, self.counter
         low, high = view.low, view.high
         if not (valid_state(a, low, high) and valid_state(b, low, high)):
             return False, 0.0
         translation, angle, jump = motion_split(a, b)
-        reach = view.part_reach
+        reach = np.append(view.part_reach, self.body.reach)  # index WHOLE (-1): the whole body
         speed = translation + (0.0 if jump else angle) * reach
         margin = angle * reach if jump else np.zeros(len(reach))
         clearance, scale = self.clearance, view.scale
@@ -370,6 +375,9 @@ class RigidBodyChecker:
         poses: dict[float, np.ndarray] = {}
         exact: dict[tuple[int, float], float] = {}
         state = np.empty(len(a))
+        whole_body, whole_world = self._whole_body, self._whole_world
+        if whole_body is not None and whole_world is not None and segments:
+            segments = [(WHOLE, t0, t1, -np.inf, -np.inf) for t0, t1 in _spans(segments)]
 
         def pose_at(t: float) -> np.ndarray:
             if t not in poses:
@@ -381,18 +389,21 @@ class RigidBodyChecker:
 
         def distance(pair: int, t: float) -> float:
             if (pair, t) not in exact:
-                part, obstacle = self._pair_objects(pair)
-                self._place(pose_at(t), pair % len(self._parts))
-                if fcl.collide(part, obstacle, _REQUEST, fcl.CollisionResult()):
+                if pair == WHOLE and whole_body is not None and whole_world is not None:
+                    first, second = whole_body, whole_world
+                    pose = pose_at(t)
+                    first.setRotation(pose[:3, :3])
+                    first.setTranslation(pose[:3, 3])
+                else:
+                    first, second = self._pair_objects(pair)
+                    self._place(pose_at(t), pair % len(self._parts))
+                if fcl.collide(first, second, _REQUEST, fcl.CollisionResult()):
                     exact[pair, t] = -np.inf
                 else:
                     counter.distance_queries += 1
-                    found = fcl.distance(part, obstacle, _DISTANCE_REQUEST, fcl.DistanceResult())
+                    found = fcl.distance(first, second, _DISTANCE_REQUEST, fcl.DistanceResult())
                     exact[pair, t] = found - DISTANCE_TOLERANCE * scale
             return exact[pair, t]
-
-        def fail(t: float) -> float:
-            return min(bad, t)
 
         if not last_valid:  # contacts first: a collision test is cheaper than a distance
             for pair, t0, t1, _, _ in segments:
@@ -404,7 +415,7 @@ class RigidBodyChecker:
             pair = int(pair)
             if t0 >= bad:
                 continue
-            g = pair % len(self._parts)
+            g = pair if pair == WHOLE else pair % len(self._parts)
             travel = speed[g] * (t1 - t0)
             need = travel + 2.0 * (clearance + margin[g])
             for t in (t0, t1) if d0 <= d1 else (t1, t0):
@@ -421,12 +432,12 @@ class RigidBodyChecker:
                     failed = True
                     if not last_valid:
                         return False, 0.0
-                    bad = fail(t)
+                    bad = min(bad, t)
             if travel < MIN_TRAVEL * scale or t0 >= bad or (failed and t1 >= bad and travel < settle):
                 failed = True
                 if not last_valid:
                     return False, 0.0
-                bad = fail(t0)
+                bad = min(bad, t0)
                 continue
             middle = 0.5 * (t0 + t1)
             dm = distance(pair, middle)
@@ -447,6 +458,17 @@ def _is_row(state: object, size: int) -> bool:
 def soup_mesh_geometry(triangles: np.ndarray) -> fcl.BVHModel:
     """FCL's BVH model of a triangle soup (t, 3, 3)."""
     return Shape.from_mesh(soup_mesh(triangles)).fcl_geometry()
+
+
+def _spans(segments: list[tuple[Any, ...]]) -> list[tuple[float, float]]:
+    """The union of the segments' ``[t0, t1]`` as disjoint spans, in order."""
+    spans: list[tuple[float, float]] = []
+    for _pair, t0, t1, _d0, _d1 in sorted(segments, key=lambda s: s[1]):
+        if spans and t0 <= spans[-1][1]:
+            spans[-1] = (spans[-1][0], max(spans[-1][1], t1))
+        else:
+            spans.append((t0, t1))
+    return spans
 
 
 def _sharper(bound: float, exact: float) -> float:
