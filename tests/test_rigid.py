@@ -372,3 +372,65 @@ def test_ompl_state_conversions_round_trip():
     with pytest.raises(ValueError, match="'SE2' or 'SE3'"):
         rigid_body_space("R3", [0.0], [1.0])
     assert isinstance(rigid_body_space("SE3", [0, 0, 0], [1, 1, 1]), ob.SE3StateSpace)
+
+
+def test_warm_up_compiles_the_kernels_real_checkers_use():
+    from ompl_balance.collision.rigid.checker import warm_up
+    from ompl_balance.worlds.rigid import rigid_problem
+
+    warm_up()
+    kernels = (state_status, edge_status)
+    before = [set(k.signatures) for k in kernels]
+    for name in ("se2_slot", "se3_room"):
+        checker = rigid_problem(name).checker()
+        checker.certify(rigid_problem(name).start, rigid_problem(name).goal)
+    assert [set(k.signatures) for k in kernels] == before
+
+
+@pytest.mark.parametrize("name", ["se2_bugtrap", "se3_slot"])
+def test_discrete_validator_matches_ompls_own(name):
+    """The batched discrete validator answers as OMPL's DiscreteMotionValidator, over the same
+    validity checker, and its last valid state is the state before the first invalid one."""
+    from ompl import geometric as og
+
+    from ompl_balance.core.counting import read_work
+    from ompl_balance.validity import RigidBodyValidityChecker, setup_rigid_body
+    from ompl_balance.worlds.rigid import rigid_problem
+
+    problem = rigid_problem(name)
+    checker = problem.checker()
+    ss = og.SimpleSetup(rigid_body_space(problem.space, problem.low.tolist(), problem.high.tolist()))
+    _, validator = setup_rigid_body(ss, checker, motion="discrete")
+    si = ss.getSpaceInformation()
+    si.setup()
+    stock = og.SimpleSetup(rigid_body_space(problem.space, problem.low.tolist(), problem.high.tolist()))
+    stock_si = stock.getSpaceInformation()
+    stock_si.setStateValidityChecker(RigidBodyValidityChecker(stock_si, problem.checker()))
+    stock_si.setup()
+    space = si.getStateSpace()
+    s1, s2, last, probe = si.allocState(), si.allocState(), si.allocState(), si.allocState()
+    rng = np.random.default_rng(9)
+    outcomes = []
+    for a, b in short_edges(problem.space, 80, rng, problem.low, problem.high, 0.6):
+        if not checker.is_valid(a):
+            continue
+        set_rigid_state(s1, a)
+        set_rigid_state(s2, b)
+        before = read_work(si)
+        valid = si.checkMotion(s1, s2)
+        assert (read_work(si) - before).motions_checked == 1
+        assert valid == stock_si.checkMotion(s1, s2)
+        valid_again, fraction = validator.check_motion_last_valid(s1, s2, last)
+        assert valid_again == valid
+        if not valid:
+            nd = space.validSegmentCount(s1, s2)
+            walk = []
+            for j in range(1, nd + 1):
+                space.interpolate(s1, s2, j / nd, probe)
+                walk.append(checker.is_valid(rigid_state_values(probe, len(a))))
+            first = walk.index(False)
+            assert fraction == pytest.approx(first / nd)
+            space.interpolate(s1, s2, first / nd, probe)
+            np.testing.assert_allclose(rigid_state_values(last, len(a)), rigid_state_values(probe, len(a)), atol=1e-9)
+        outcomes.append(valid)
+    assert 5 <= sum(outcomes) <= len(outcomes) - 5

@@ -23,7 +23,7 @@ import trimesh
 from numpy.typing import ArrayLike
 
 from ..convex import convex_part
-from ..geometry import Shape, pose_matrix
+from ..geometry import Shape
 from .pieces import soup_mesh, split_triangles
 
 #: The state spaces a rigid body moves in, and the length of their states.
@@ -130,16 +130,3 @@ class RigidBody:
             if len(bad):
                 raise ValueError(f"state {bad[0]} has a quaternion of norm {norms[bad[0]]!r}; it must be 1 (to 1e-9)")
         return np.ascontiguousarray(rows)
-
-    def poses(self, states: ArrayLike) -> np.ndarray:
-        """Body frame poses (n, 4, 4) of ``states`` (n, 3) or (n, 7)."""
-        rows = self.as_states(states)
-        poses = np.tile(np.eye(4), (len(rows), 1, 1))
-        if self.space == "SE2":
-            cos, sin = np.cos(rows[:, 2]), np.sin(rows[:, 2])
-            poses[:, 0, 0], poses[:, 0, 1], poses[:, 1, 0], poses[:, 1, 1] = cos, -sin, sin, cos
-            poses[:, :2, 3] = rows[:, :2]
-        else:
-            for pose, row in zip(poses, rows):
-                pose[:] = pose_matrix(row[:3], row[3:])
-        return poses

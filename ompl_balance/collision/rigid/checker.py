@@ -5,13 +5,15 @@ among the obstacles of an :class:`~ompl_balance.collision.environment.Environmen
 
 * *is this state free?* (:meth:`~RigidBodyChecker.is_valid`, batched :meth:`~RigidBodyChecker.check`):
   the compiled screening (:func:`~ompl_balance.collision.rigid.view.state_status`), then FCL's
-  exact test (BVH meshes, FCL primitives) on the pairs it could not clear. The answer is
-  FCL's, as OMPL.app's checker (one mesh against the other) gives it: FCL tests triangles, so
-  a body entirely inside a closed obstacle mesh, without touching it, is free for both;
+  exact test (BVH meshes, FCL primitives) of what it could not decide: a body of meshes whole,
+  against the whole world when that is meshes too (one call, as OMPL.app's checker makes it),
+  else against each obstacle left. The answer is FCL's: FCL tests triangles, so a body
+  entirely inside a closed obstacle mesh, without touching it, is free (for OMPL.app too);
 * *is this motion free?* (:meth:`~RigidBodyChecker.certify`): the motion OMPL's
   ``interpolate`` traces is certified by conservative advancement
   (:func:`~ompl_balance.collision.rigid.advance.edge_status`), FCL's exact distances finishing
-  the segments of pairs with non-convex meshes. "Certified" means every pair stays more than
+  the segments of pairs with non-convex meshes (the whole body against the whole world when
+  both are meshes). "Certified" means every pair stays more than
   ``clearance`` apart at every point of the motion, for the model FCL tests (meshes that are
   convex count as their solid hulls; every exact distance is taken less
   :data:`~ompl_balance.collision.advancement.DISTANCE_TOLERANCE` times the view's scale).
@@ -185,10 +187,23 @@ class RigidBodyChecker:
         for chunk in (order[:first_chunk], order[first_chunk:]):
             if len(chunk) == 0:
                 continue
-            valid = self.check(rows[chunk])
-            bad = np.flatnonzero(~valid)
-            if len(bad):
-                return int(chunk[bad[0]])
+            self.counter.states_checked += len(chunk)
+            if not self.prefilter:
+                hit = next((k for k, row in enumerate(rows[chunk]) if not self._valid_reference(row)), -1)
+            else:
+                poses = np.empty((len(chunk), 4, 4))
+                undecided = np.empty((len(chunk), len(self._obstacles) * len(self._parts)), dtype=bool)
+                status = self._batch_kernel(self.view, np.ascontiguousarray(rows[chunk]), poses, undecided)
+                hit = next(
+                    (
+                        k
+                        for k in np.flatnonzero(status != FREE).tolist()
+                        if status[k] == COLLIDING or not self._free_pairs(poses[k], np.flatnonzero(undecided[k]))
+                    ),
+                    -1,
+                )
+            if hit >= 0:
+                return int(chunk[hit])
         return -1
 
     # ------------------------------------------------------------------ motions
@@ -205,7 +220,7 @@ class RigidBodyChecker:
         a, b = self._row(a), self._row(b)
         self.counter.motions_checked += 1
         if not self.prefilter:
-            return self._finish_edge(a, b, self._whole_edge(a, b), 1.0, False, last_valid)
+            return self._finish_edge(a, b, self._whole_edge(), 1.0, False, last_valid)
         status, fraction = self._edge_kernel(self.view, a, b, last_valid)
         self._count_kernel_work()
         if status == FREE:
@@ -231,7 +246,7 @@ class RigidBodyChecker:
         a, b = self._row(a), self._row(b)
         hard, bad = int(self.view.counts[HARD_SEGMENTS]), float(self.view.reached[0])
         if hard < 0:  # more than the view holds: every pair over the whole motion
-            return self._finish_edge(a, b, self._whole_edge(a, b), 1.0, False, last_valid)
+            return self._finish_edge(a, b, self._whole_edge(), 1.0, False, last_valid)
         segments = [tuple(row) for row in self.view.hard[:hard].tolist()]
         return self._finish_edge(a, b, segments, bad, bad < 1.0, last_valid)
 
@@ -340,7 +355,7 @@ class RigidBodyChecker:
         state_pose(row, pose)
         return self._free_pairs(pose, np.arange(len(self._obstacles) * len(self._parts)))
 
-    def _whole_edge(self, a: np.ndarray, b: np.ndarray) -> list[tuple[float, ...]]:
+    def _whole_edge(self) -> list[tuple[float, ...]]:
         """Every pair over the whole motion, without bounds: what FCL alone must certify."""
         return [(pair, 0.0, 1.0, -np.inf, -np.inf) for pair in range(len(self._obstacles) * len(self._parts))]
 
@@ -512,3 +527,18 @@ def certify_rigid_states(checker: RigidBodyChecker, states: np.ndarray, clearanc
         smallest_clearance=smallest,
         clearance=clearance,
     )
+
+
+def warm_up() -> None:
+    """Compile the rigid-body kernels, or load them from numba's cache, for the argument types
+    every checker passes (a small body and box stand in), as
+    :func:`~ompl_balance.collision.screening.warm_up` does for robots: spent here instead of in a
+    problem's first check (a process that imports this and calls it, e.g. a benchmark runner's
+    forkserver, starts its runs warm)."""
+    environment = Environment()
+    environment.add_box("box", (0.1, 0.1, 0.1), (1.0, 0.0, 0.0))
+    body = RigidBody("SE3", [("sphere", Shape.sphere(0.1), None)], name="warm-up")
+    checker = RigidBodyChecker(body, environment)
+    start, end = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]), np.array([2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
+    checker.check(np.stack([start, end]))
+    checker.certify(start, end)
