@@ -13,7 +13,8 @@ runner (:mod:`ompl_balance.bench`).
 
 The robot layer (trimesh, FCL, numba) and the benchmark runner are imported on first
 use, so ``import ompl_balance`` stays quick when they are not needed: their names
-(``CollisionChecker``, ``setup_robot``, ``load_mbm``, ``bench``, ...) are attributes of
+(``CollisionChecker``, ``setup_robot``, ``load_mbm``, ``RigidBodyChecker``, ``load_omplapp``,
+``rigid_problem``, ``bench``, ...) are attributes of
 this package but not in ``__all__``, so ``from ompl_balance import *`` does not load them.
 """
 
@@ -89,6 +90,19 @@ _LAZY = {
     "setup_robot": "validity",
     "load_mbm": "worlds.mbm",
     "MBMProblem": "worlds.mbm",
+    "RigidBody": "collision.rigid.body",
+    "RigidBodyChecker": "collision.rigid.checker",
+    "RigidView": "collision.rigid.view",
+    "RigidBodyValidityChecker": "validity",
+    "RigidBodyMotionValidator": "validity",
+    "RigidBodyCertifiedMotionValidator": "validity",
+    "rigid_body_space": "validity",
+    "setup_rigid_body": "validity",
+    "RigidBodyProblem": "worlds.rigid",
+    "RIGID_PROBLEMS": "worlds.rigid",
+    "rigid_problem": "worlds.rigid",
+    "load_omplapp": "worlds.omplapp",
+    "read_omplapp_path": "worlds.omplapp",
     "Experiment": "bench.experiment",
     "ProblemSpec": "bench.problems",
     "PlannerSpec": "bench.experiment",

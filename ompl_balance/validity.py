@@ -1,6 +1,7 @@
 """OMPL adapters for robots: a state validity checker and two motion validators backed by a
 :class:`~ompl_balance.collision.checker.CollisionChecker`, the joint space, :func:`setup_robot`
-and :func:`certify_path`.
+and :func:`certify_path`; the same for rigid bodies in SE(2) and SE(3) backed by a
+:class:`~ompl_balance.collision.rigid.checker.RigidBodyChecker` (:func:`setup_rigid_body`).
 
 Motion validators:
 
@@ -18,6 +19,7 @@ planner made them do.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -31,8 +33,11 @@ from .collision.kernels import (
     RobotDiscreteMotions,
     robot_discrete_motion_free,
     robot_discrete_motions,
+    visiting_order,
 )
 from .collision.kinematics import RobotModel
+from .collision.rigid.checker import RigidBodyChecker, certify_rigid_states
+from .collision.rigid.motion import interpolate, interpolate_many
 from .core.compiled_calls import entry_point
 from .core.layout import layout_for
 
@@ -271,7 +276,7 @@ def setup_robot(
 
 
 def certify_path(
-    checker: CollisionChecker, states: np.ndarray | og.PathGeometric, clearance: float = 0.0
+    checker: CollisionChecker | RigidBodyChecker, states: np.ndarray | og.PathGeometric, clearance: float = 0.0
 ) -> PathCertificate:
     """Certify a path's straight joint-space segments for ``checker``'s model.
 
@@ -280,8 +285,212 @@ def certify_path(
     whether every segment is certified with ``clearance`` metres to spare, the first
     segment that is not (and how much of it is), and the smallest exact distance at the
     path's states. Counts its work in the checker's counter.
+
+    With a :class:`RigidBodyChecker` the segments are rigid-body motions along OMPL's
+    interpolation and ``states`` are ``(n, 3)`` (SE(2)) or ``(n, 7)`` (SE(3)) rows.
     """
+    if isinstance(checker, RigidBodyChecker):
+        if isinstance(states, og.PathGeometric):
+            size = checker.body.state_size
+            states = np.array([rigid_state_values(states.getState(i), size) for i in range(states.getStateCount())])
+        return certify_rigid_states(checker, np.asarray(states, dtype=float), clearance)
     if isinstance(states, og.PathGeometric):
         dof = checker.robot.dof
         states = np.array([states.getState(i)[0:dof] for i in range(states.getStateCount())]).reshape(-1, dof)
     return certify_states(checker, states, clearance)
+
+
+# -- rigid bodies -------------------------------------------------------------------------
+#
+# A RigidBodyChecker's body moves in SE(2) or SE(3); its states are OMPL's SE2StateSpace and
+# SE3StateSpace states, read as (x, y, yaw) and (x, y, z, qx, qy, qz, qw).
+
+
+def rigid_body_space(space: str, low: Sequence[float], high: Sequence[float]) -> ob.StateSpace:
+    """OMPL's ``SE2StateSpace`` (``space="SE2"``) or ``SE3StateSpace`` (``"SE3"``) with position
+    bounds ``low``/``high`` (2 or 3 numbers each)."""
+    axes = {"SE2": 2, "SE3": 3}.get(space)
+    if axes is None:
+        raise ValueError(f"space must be 'SE2' or 'SE3', got {space!r}")
+    if len(low) != axes or len(high) != axes:
+        raise ValueError(f"{space} position bounds are {axes} numbers each, got low {list(low)}, high {list(high)}")
+    state_space = ob.SE2StateSpace() if axes == 2 else ob.SE3StateSpace()
+    bounds = ob.RealVectorBounds(axes)
+    for i, (lo, hi) in enumerate(zip(low, high)):
+        bounds.setLow(i, float(lo))
+        bounds.setHigh(i, float(hi))
+    state_space.setBounds(bounds)
+    return state_space
+
+
+def rigid_state_values(state: ob.State, size: int) -> np.ndarray:
+    """An SE(2) (``size`` 3) or SE(3) (``size`` 7) OMPL state as ``(x, y, yaw)`` or ``(x, y, z, qx, qy, qz, qw)``."""
+    if size == 3:
+        return np.array((state.getX(), state.getY(), state.getYaw()))
+    rotation = state.rotation()
+    return np.array((state.getX(), state.getY(), state.getZ(), rotation.x, rotation.y, rotation.z, rotation.w))
+
+
+def set_rigid_state(state: ob.State, values: np.ndarray) -> None:
+    """Write ``(x, y, yaw)`` or ``(x, y, z, qx, qy, qz, qw)`` into an SE(2) or SE(3) OMPL state."""
+    if len(values) == 3:
+        state.setXY(float(values[0]), float(values[1]))
+        state.setYaw(float(values[2]))
+        return
+    state.setXYZ(float(values[0]), float(values[1]), float(values[2]))
+    rotation = state.rotation()
+    rotation.x, rotation.y, rotation.z, rotation.w = (float(v) for v in values[3:])
+
+
+class RigidBodyValidityChecker(ob.StateValidityChecker):
+    """OMPL state validity checker backed by a :class:`RigidBodyChecker` (counts each state)."""
+
+    def __init__(self, si: ob.SpaceInformation, checker: RigidBodyChecker):
+        _check_rigid_space(si, checker)
+        super().__init__(si)
+        self.checker = checker
+        self._size = checker.body.state_size
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
+        return self.checker.is_valid(rigid_state_values(state, self._size))
+
+    def counters(self) -> dict[str, int]:
+        return self.checker.counters()
+
+    def reset_counters(self) -> None:
+        self.checker.reset_counters()
+
+
+class _RigidBodyMotionValidator(ob.MotionValidator):
+    """What the two rigid-body motion validators share: the checker, its counters, reading
+    states, and ``last_valid`` set along OMPL's interpolation."""
+
+    def __init__(self, si: ob.SpaceInformation, checker: RigidBodyChecker):
+        _check_rigid_space(si, checker)
+        super().__init__(si)
+        self.checker = checker
+        self._size = checker.body.state_size
+
+    def counters(self) -> dict[str, int]:
+        return self.checker.counters()
+
+    def reset_counters(self) -> None:
+        self.checker.reset_counters()
+
+    def _values(self, state: ob.State) -> np.ndarray:
+        return rigid_state_values(state, self._size)
+
+    @staticmethod
+    def _set_last_valid(last_valid: ob.State | None, a: np.ndarray, b: np.ndarray, fraction: float) -> None:
+        """Set ``last_valid`` (if given) to OMPL's ``interpolate(a, b, fraction)`` (``a`` itself at 0)."""
+        if last_valid is None:
+            return
+        values = a.copy()
+        if fraction > 0.0:
+            interpolate(a, b, fraction, values)
+        set_rigid_state(last_valid, values)
+
+
+class RigidBodyMotionValidator(_RigidBodyMotionValidator):
+    """OMPL-style discrete motion validator for a rigid body, the states checked in one batch.
+
+    The states OMPL's ``DiscreteMotionValidator`` checks (``interpolate(s1, s2, j / nd)``,
+    ``j = 1 .. nd``, ``nd = space.validSegmentCount(s1, s2)``), ``s2`` first on the single-state
+    path, then the others coarse to fine (:func:`~ompl_balance.collision.kernels.visiting_order`) in one screening batch, FCL
+    running until the first collision. What lies between the states is not looked at.
+    """
+
+    def __init__(self, si: ob.SpaceInformation, checker: RigidBodyChecker):
+        super().__init__(si, checker)
+        self._space = si.getStateSpace()
+
+    def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
+        return self.check_motion_last_valid(s1, s2)[0]
+
+    def check_motion_last_valid(
+        self, s1: ob.State, s2: ob.State, last_valid: ob.State | None = None
+    ) -> tuple[bool, float]:
+        """Validity of the edge and the fraction ``t`` of it known valid, as
+        :meth:`MotionValidator.check_motion_last_valid` (for states along OMPL's interpolation)."""
+        checker = self.checker
+        checker.counter.motions_checked += 1
+        a, b = self._values(s1), self._values(s2)
+        if not (np.isfinite(a).all() and np.isfinite(b).all()):
+            self._set_last_valid(last_valid, a, b, 0.0)
+            return False, 0.0
+        if last_valid is None and not checker.is_valid(b):
+            return False, 1.0
+        nd = self._space.validSegmentCount(s1, s2)
+        t = np.arange(1, nd + 1) / nd
+        states = np.empty((nd, len(a)))
+        interpolate_many(a, b, t, states)
+        if last_valid is None:
+            return nd == 1 or checker.first_collision(states[:-1], visiting_order(nd)[1:], first_chunk=0) < 0, 1.0
+        first = checker.first_collision(states)
+        if first < 0:
+            return True, 1.0
+        fraction = first / nd
+        self._set_last_valid(last_valid, a, b, fraction)
+        return False, fraction
+
+
+class RigidBodyCertifiedMotionValidator(_RigidBodyMotionValidator):
+    """OMPL motion validator that proves each rigid-body motion free of collision, or rejects it.
+
+    The motion ``s1 -> s2`` is what OMPL's ``interpolate`` traces (translation on a straight
+    line, rotation along the shortest arc); it is valid when every pair (obstacle, body part)
+    of ``checker``'s model stays more than ``checker.clearance`` apart along all of it
+    (:meth:`RigidBodyChecker.certify`: conservative advancement with distance lower bounds
+    against the body's travel). States that are not valid (outside the bounds, not finite)
+    make a motion invalid. Counts in the checker's counter: one motion per edge, the poses
+    evaluated as states, the distance queries.
+    """
+
+    def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
+        return self.checker.certify(self._values(s1), self._values(s2))[0]
+
+    def check_motion_last_valid(
+        self, s1: ob.State, s2: ob.State, last_valid: ob.State | None = None
+    ) -> tuple[bool, float]:
+        """Validity of the edge and the fraction ``t`` of it certified from ``s1`` (as
+        :meth:`CertifiedMotionValidator.check_motion_last_valid`)."""
+        a, b = self._values(s1), self._values(s2)
+        valid, fraction = self.checker.certify(a, b, last_valid=last_valid is not None)
+        if not valid:
+            self._set_last_valid(last_valid, a, b, fraction)
+        return valid, fraction
+
+
+def _check_rigid_space(si: ob.SpaceInformation, checker: RigidBodyChecker) -> None:
+    space = si.getStateSpace()
+    expected = ob.SE2StateSpace if checker.body.space == "SE2" else ob.SE3StateSpace
+    if not isinstance(space, expected):
+        raise ValueError(
+            f"rigid body {checker.body.name!r} moves in {checker.body.space}; the space information's state space "
+            f"is {type(space).__name__}, expected {expected.__name__}"
+        )
+
+
+def setup_rigid_body(
+    ss_or_si: og.SimpleSetup | ob.SpaceInformation, checker: RigidBodyChecker, motion: str = "certified"
+) -> tuple[RigidBodyValidityChecker, RigidBodyCertifiedMotionValidator | RigidBodyMotionValidator]:
+    """Install ``checker`` as state validity checker, and a motion validator, for a rigid body.
+
+    ``ss_or_si``: an ``og.SimpleSetup`` or ``ob.SpaceInformation`` over an ``SE2StateSpace`` or
+    ``SE3StateSpace`` (e.g. from :func:`rigid_body_space`), as the body moves. ``motion``:
+    ``"certified"`` (:class:`RigidBodyCertifiedMotionValidator`, keeping ``checker.clearance``)
+    or ``"discrete"`` (:class:`RigidBodyMotionValidator`, OMPL's discrete states only). Call
+    before ``setup()``/``solve()``. Returns the two installed objects.
+    """
+    if motion not in MOTION_VALIDATORS:
+        raise ValueError(f"motion must be one of {', '.join(map(repr, MOTION_VALIDATORS))}, got {motion!r}")
+    si = ss_or_si.getSpaceInformation() if isinstance(ss_or_si, og.SimpleSetup) else ss_or_si
+    validity = RigidBodyValidityChecker(si, checker)
+    validator: RigidBodyCertifiedMotionValidator | RigidBodyMotionValidator
+    if motion == "certified":
+        validator = RigidBodyCertifiedMotionValidator(si, checker)
+    else:
+        validator = RigidBodyMotionValidator(si, checker)
+    si.setStateValidityChecker(validity)
+    si.setMotionValidator(validator)
+    return validity, validator

@@ -177,6 +177,14 @@ def coarse_to_fine(n: int, order: np.ndarray, intervals: np.ndarray) -> None:  #
         tail += 2
 
 
+def visiting_order(n: int) -> np.ndarray:
+    """:func:`coarse_to_fine`'s order of the states ``j / n``, ``j = 1 .. n``, as an ``(n,)`` array
+    of indices ``j - 1``: the end state first, then breadth-first bisection."""
+    order = np.empty(n, dtype=np.int64)
+    coarse_to_fine(n, order, np.empty((2 * n + 1, 2), dtype=np.int64))
+    return order
+
+
 @njit(cache=True)
 def robot_discrete_motion_free(view: RobotDiscreteMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """:meth:`MotionValidator.checkMotion` of ``a -> b``: ``b`` on the single-state path (it decides
