@@ -2,8 +2,8 @@
 
 ``ompl-balance compare``
     stock ``og.RRTConnect`` against ``BalancedRRTConnect`` (balancing on and off), or
-    the planners given with ``--planners``, on the built-in 2-D problems and problem 1 of
-    each MotionBenchMaker Panda scenario; prints per problem the success rate, median
+    the planners given with ``--planners``, on the built-in 2-D problems, problem 1 of
+    each MotionBenchMaker Panda scenario and two shipped rigid-body problems; prints per problem the success rate, median
     time, validity checks and nodes, each with its 95 % interval and its ratio to stock
     RRT-Connect. With ``-o OUT`` the runs are kept, and the same command resumes.
 ``ompl-balance bench EXPERIMENT.toml -o OUT/``
@@ -36,7 +36,14 @@ from pathlib import Path
 import numpy as np
 from ompl import util as ou
 
-from .bench.compare import COMPARE_MBM_PROBLEMS, COMPARE_SEED, bench, compare_experiment, parse_planners
+from .bench.compare import (
+    COMPARE_MBM_PROBLEMS,
+    COMPARE_RIGID_PROBLEMS,
+    COMPARE_SEED,
+    bench,
+    compare_experiment,
+    parse_planners,
+)
 from .bench.errors import ExperimentError, MissingExtraError
 from .bench.experiment import Experiment, PlannerSpec
 from .bench.experiment_file import load_experiment
@@ -45,6 +52,7 @@ from .bench.scheduling import require_dask
 from .gamma import ball_radius_constant, estimate_free_measure, ompl_rewire_factor, rewire_radius
 from .worlds.boxes import PROBLEMS
 from .worlds.occupancy import OCCUPANCY_PROBLEMS, OccupancyGrid, OccupancyProblem
+from .worlds.rigid import RIGID_PROBLEMS
 
 
 def _problem_names(text: str) -> list[str]:
@@ -150,9 +158,10 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument(
         "--problems",
         type=_problem_names,
-        default=[*PROBLEMS, *COMPARE_MBM_PROBLEMS],
-        help=f"comma-separated problems: built-in 2-D ({', '.join(PROBLEMS)}) and MotionBenchMaker Panda "
-        f"problems SCENARIO.ID (default: all 2-D ones and {', '.join(COMPARE_MBM_PROBLEMS)})",
+        default=[*PROBLEMS, *COMPARE_MBM_PROBLEMS, *COMPARE_RIGID_PROBLEMS],
+        help=f"comma-separated problems: built-in 2-D ({', '.join(PROBLEMS)}), MotionBenchMaker Panda "
+        f"problems SCENARIO.ID and shipped rigid-body problems ({', '.join(RIGID_PROBLEMS)}) (default: all "
+        f"2-D ones, {', '.join(COMPARE_MBM_PROBLEMS)}, {', '.join(COMPARE_RIGID_PROBLEMS)})",
     )
     compare.add_argument(
         "--planners",

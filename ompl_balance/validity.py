@@ -37,6 +37,7 @@ from .collision.kernels import (
 )
 from .collision.kinematics import RobotModel
 from .collision.rigid.checker import RigidBodyChecker, certify_rigid_states
+from .collision.rigid.kernels import RigidCertifiedMotions, RigidStates
 from .collision.rigid.motion import interpolate, interpolate_many
 from .core.compiled_calls import entry_point
 from .core.layout import layout_for
@@ -354,6 +355,10 @@ class RigidBodyValidityChecker(ob.StateValidityChecker):
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         return self.checker.is_valid(rigid_state_values(state, self._size))
 
+    def compiled_view(self) -> RigidStates | None:
+        """The checker's view for compiled code (:class:`~ompl_balance.collision.rigid.kernels.RigidStates`)."""
+        return self.checker.kernel_view()
+
     def counters(self) -> dict[str, int]:
         return self.checker.counters()
 
@@ -396,9 +401,13 @@ class RigidBodyMotionValidator(_RigidBodyMotionValidator):
 
     The states OMPL's ``DiscreteMotionValidator`` checks (``interpolate(s1, s2, j / nd)``,
     ``j = 1 .. nd``, ``nd = space.validSegmentCount(s1, s2)``), ``s2`` first on the single-state
-    path, then the others coarse to fine (:func:`~ompl_balance.collision.kernels.visiting_order`) in one screening batch, FCL
-    running until the first collision. What lies between the states is not looked at.
+    path, then the others coarse to fine (:func:`~ompl_balance.collision.kernels.visiting_order`)
+    in one screening batch, FCL running until the first collision. What lies between the states
+    is not looked at. The compiled engine checks these states as it checks OMPL's own
+    ``DiscreteMotionValidator``'s (:attr:`checks_as_discrete`), with the checker's kernels.
     """
+
+    checks_as_discrete = True
 
     def __init__(self, si: ob.SpaceInformation, checker: RigidBodyChecker):
         super().__init__(si, checker)
@@ -448,6 +457,11 @@ class RigidBodyCertifiedMotionValidator(_RigidBodyMotionValidator):
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         return self.checker.certify(self._values(s1), self._values(s2))[0]
+
+    def compiled_view(self) -> RigidCertifiedMotions | None:
+        """The validator as compiled code sees it (:class:`~ompl_balance.collision.rigid.kernels.RigidCertifiedMotions`)."""
+        states = self.checker.kernel_view()
+        return None if states is None else RigidCertifiedMotions(states, states.counts)
 
     def check_motion_last_valid(
         self, s1: ob.State, s2: ob.State, last_valid: ob.State | None = None

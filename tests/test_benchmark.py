@@ -21,7 +21,7 @@ from ompl_balance.bench.experiment import Experiment, PlannerSpec, run_seed
 from ompl_balance.bench.experiment_file import load_experiment
 from ompl_balance.bench.isolation import run_isolated
 from ompl_balance.bench.logs import write_logs
-from ompl_balance.bench.problems import ProblemSpec
+from ompl_balance.bench.problems import ProblemSpec, problem_by_name
 from ompl_balance.bench.progress_sampler import ProgressSampler
 from ompl_balance.bench.summary import summarize
 from ompl_balance.cli import main
@@ -148,6 +148,40 @@ def test_mbm_problems_select_the_motion_validator(tmp_path):
         assert type(ss.getSpaceInformation().getMotionValidator()) is validator
     with pytest.raises(ExperimentError, match=r"problems\[0\].motion: must be one of certified, discrete"):
         load_experiment(write(tmp_path, problem('\nmotion = "exact"')))
+
+
+def test_rigid_problems_by_name_or_omplapp_file_with_their_motion_validator(tmp_path):
+    """``rigid = NAME`` builds the shipped problem (certified motions unless ``motion`` says
+    otherwise); an OMPL.app ``.cfg`` file is read relative to the experiment file; a name that is
+    neither is refused naming the key, the line and what is accepted."""
+    from test_omplapp import SE3_LINES, box, collada, write_cfg
+
+    from ompl_balance.validity import RigidBodyCertifiedMotionValidator, RigidBodyMotionValidator
+
+    def problem(source: str, extra: str = "") -> str:
+        return GOOD.replace('builtin = "open"', f'rigid = "{source}"' + extra)
+
+    for extra, validator in (
+        ("", RigidBodyCertifiedMotionValidator),
+        ('\nmotion = "discrete"', RigidBodyMotionValidator),
+    ):
+        spec = load_experiment(write(tmp_path, problem("se2_slot", extra))).problems[0]
+        assert spec.name == "se2_slot"
+        ss = spec.build()
+        assert type(ss.getSpaceInformation().getMotionValidator()) is validator
+        assert ss.getSpaceInformation().getStateSpace().getDimension() == 3  # SE(2)
+    collada(tmp_path / "robot.dae", *box([-1.0, -0.5, -0.25], [1.0, 0.5, 0.25]))
+    collada(tmp_path / "world.dae", *box([-5.0, -5.0, 4.0], [5.0, 5.0, 5.0]))
+    cfg = write_cfg(tmp_path, SE3_LINES)
+    spec = load_experiment(write(tmp_path, problem(cfg.name, '\nname = "mine"'))).problems[0]
+    assert (spec.name, spec.source, len(spec.data)) == ("mine", str(cfg.resolve()), 16)
+    assert spec.build().getSpaceInformation().getStateSpace().getDimension() == 6  # SE(3)
+    with pytest.raises(
+        ExperimentError, match=r"line 7: problems\[0\].rigid: .se3_nowhere. is neither a shipped problem \(se2_slot"
+    ):
+        load_experiment(write(tmp_path, problem("se3_nowhere")))
+    assert problem_by_name("se3_room").kind == "rigid"
+    assert {"se2_bugtrap", "se3_room"} <= {p.name for p in compare_experiment().problems}
 
 
 def test_planner_list_syntax_of_compare():

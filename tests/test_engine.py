@@ -219,6 +219,47 @@ def test_a_panda_problem_on_both_engines(motion):
     assert_same_run(solve(make, "python", seed=4), solve(make, "compiled", seed=4))
 
 
+def rigid_setup(name, motion):
+    from ompl_balance import rigid_problem
+
+    problem = rigid_problem(name)
+    return lambda: problem.simple_setup(motion=motion)
+
+
+@pytest.mark.parametrize("name", ["se2_slot", "se3_slot"])
+def test_the_rigid_body_checkers_kernels_give_the_python_engines_runs(name):
+    """Certified rigid-body motions: the engine calls the checker's kernels (FCL through its
+    exits); SE(2) gives the same trees, SE(3) the same work (see the quaternion note below)."""
+    make = rigid_setup(name, "certified")
+    python = solve(make, "python", seed=2)
+    compiled = solve(make, "compiled", seed=2)
+    assert python[0][0] == "Exact solution"
+    if name == "se2_slot":
+        assert_same_run(python, compiled)
+    else:
+        assert python[0][1] == compiled[0][1]
+    ss = make()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    planner.setSeed(2)
+    ss.setPlanner(planner)
+    assert ss.solve(20.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.stats.checks == "kernel" and planner.stats.exits > 0
+
+
+@pytest.mark.slow
+def test_the_rigid_body_discrete_validator_is_checked_as_ompls_by_the_kernels():
+    """The same trees; the Python validator screens a motion's states in one batch (and counts
+    them all), the kernels one at a time up to the first collision (and count those)."""
+    make = rigid_setup("se2_slot", "discrete")
+    python = solve(make, "python", seed=2)
+    compiled = solve(make, "compiled", seed=2)
+    assert python[0][0] == "Exact solution"
+    screened, checked = python[0][1].pop("states_checked"), compiled[0][1].pop("states_checked")
+    assert 0 < checked <= screened
+    assert_same_run(python, compiled)
+
+
 # -- SE(3) and the flat layouts' geometry ----------------------------------------------------------
 
 

@@ -43,6 +43,9 @@ COMPARE_SEED = 1
 #: The MotionBenchMaker problems ``compare`` runs by default: problem 1 of each shipped Panda scenario.
 COMPARE_MBM_PROBLEMS = ("table_pick.001", "table_under_pick.001", "box.001", "bookshelf_small.001")
 
+#: The rigid-body problems ``compare`` runs by default: one in the plane, one in space.
+COMPARE_RIGID_PROBLEMS = ("se2_bugtrap", "se3_room")
+
 
 def default_planners() -> list[PlannerSpec]:
     """Stock ``og.RRTConnect`` (the baseline) and ``BalancedRRTConnect`` with balancing on and off."""
@@ -80,15 +83,16 @@ def parse_planners(text: str) -> list[PlannerSpec]:
 
 
 def compare_experiment(
-    problems: Sequence[str] = (*PROBLEMS, *COMPARE_MBM_PROBLEMS),
+    problems: Sequence[str] = (*PROBLEMS, *COMPARE_MBM_PROBLEMS, *COMPARE_RIGID_PROBLEMS),
     planners: Sequence[PlannerSpec] | None = None,
     runs: int = 20,
     time_limit: float = 5.0,
     seed: int = COMPARE_SEED,
     warm_up: bool = True,
 ) -> Experiment:
-    """The ``ompl-balance compare`` experiment: the built-in 2-D problems and problem 1 of each
-    MotionBenchMaker Panda scenario, stock RRTConnect as the baseline."""
+    """The ``ompl-balance compare`` experiment: the built-in 2-D problems, problem 1 of each
+    MotionBenchMaker Panda scenario and two shipped rigid-body problems, stock RRTConnect as the
+    baseline."""
     planners = list(planners or default_planners())
     return Experiment(
         name="compare",

@@ -2,7 +2,7 @@
 
 Each kind is one entry of :data:`PROBLEM_KINDS`, which says everything the benchmark does
 differently for it: the key that names it in an experiment file (``builtin = "narrow_gap"``,
-``mbm = "box"``, ``factory = "module:function"``), the other keys its table takes, how a
+``mbm = "box"``, ``rigid = "se3_room"``, ``factory = "module:function"``), the other keys its table takes, how a
 table becomes specs, how a run builds a spec's ``og.SimpleSetup``, which modules a sweep's
 forkserver imports for it, and which names ``ompl-balance compare --problems`` takes. A new
 kind of problem is a new entry.
@@ -32,7 +32,8 @@ class ProblemSpec:
     ``ompl_balance.worlds.boxes.PROBLEMS``), ``"mbm"`` (``source`` is a shipped
     MotionBenchMaker scenario or a JSON file, ``problem_id`` the problem's id, ``robot``
     the robot folder, empty for the shipped Panda, and ``motion`` the motion validator,
-    ``"certified"`` or ``"discrete"``) or ``"factory"`` (``source`` is ``"module:function"``
+    ``"certified"`` or ``"discrete"``), ``"rigid"`` (``source`` a shipped rigid-body problem or
+    an OMPL.app ``.cfg`` file, ``motion`` as for ``"mbm"``) or ``"factory"`` (``source`` is ``"module:function"``
     called with ``args``). ``name`` is unique in the experiment and names its log file.
     ``data`` is a digest of the files the problem is read from when they are not shipped
     with the package, so that an edited file makes a new problem.
@@ -219,6 +220,59 @@ def _build_mbm(spec: ProblemSpec) -> og.SimpleSetup:
     return problem_setup(spec.source, spec.problem_id, spec.robot, spec.motion or "certified")
 
 
+# -- rigid bodies ---------------------------------------------------------------------------
+
+
+def _rigid_by_name(name: str) -> ProblemSpec | None:
+    from ..worlds.rigid import RIGID_PROBLEMS
+
+    return ProblemSpec(name, "rigid", name, motion="certified") if name in RIGID_PROBLEMS else None
+
+
+def _rigid_names() -> str:
+    from ..worlds.rigid import RIGID_PROBLEMS
+
+    return f"rigid bodies: {', '.join(RIGID_PROBLEMS)}"
+
+
+def _read_rigid(table: Mapping[str, Any], where: str, base_dir: Path) -> list[ProblemSpec]:
+    from ..validity import MOTION_VALIDATORS
+    from ..worlds.mbm import files_digest
+    from ..worlds.omplapp import load_omplapp
+    from ..worlds.rigid import RIGID_PROBLEMS
+
+    source, data = table["rigid"], ""
+    if not isinstance(source, str):
+        raise ExperimentError(f"{where}.rigid", "must be a shipped problem's name or an OMPL.app .cfg file", source)
+    if source not in RIGID_PROBLEMS:  # an OMPL.app problem file, relative to the experiment file
+        path = (base_dir / source).resolve()
+        if not path.is_file():
+            raise ExperimentError(
+                f"{where}.rigid",
+                f"{source!r} is neither a shipped problem ({', '.join(RIGID_PROBLEMS)}) "
+                f"nor a file (looked for {str(path)!r})",
+                source,
+            )
+        try:
+            load_omplapp(path, validate=False)
+        except ValueError as error:
+            raise ExperimentError(f"{where}.rigid", str(error), source) from error
+        source, data = str(path), files_digest([path])
+    motion = table.get("motion", "certified")
+    if motion not in MOTION_VALIDATORS:
+        raise ExperimentError(
+            f"{where}.motion", f"must be one of {', '.join(MOTION_VALIDATORS)}, got {motion!r}", motion
+        )
+    name = str(table.get("name", Path(source).stem))
+    return [ProblemSpec(name, "rigid", source, data=data, motion=motion)]
+
+
+def _build_rigid(spec: ProblemSpec) -> og.SimpleSetup:
+    from ..worlds.rigid import rigid_problem
+
+    return rigid_problem(spec.source).simple_setup(motion=spec.motion or "certified")
+
+
 # -- the user's own problems --------------------------------------------------------------
 
 
@@ -253,6 +307,14 @@ PROBLEM_KINDS: dict[str, ProblemKind] = {
         by_name=_mbm_by_name,
         names=_mbm_names,
         scenarios=True,
+    ),
+    "rigid": ProblemKind(
+        frozenset({"name", "motion"}),
+        _read_rigid,
+        _build_rigid,
+        preload=("ompl_balance.bench.preload_rigid",),
+        by_name=_rigid_by_name,
+        names=_rigid_names,
     ),
     "factory": ProblemKind(frozenset({"name", "args"}), _read_factory, _build_factory),
 }

@@ -5,7 +5,7 @@ Three kinds of check view (:mod:`ompl_balance.core.checks`), chosen by :func:`ch
 * a motion validator's own view (the package's robot validators): its kernels decide
   states and motions;
 * :class:`DiscreteMotions`: OMPL's ``DiscreteMotionValidator`` (the default of a space
-  information) around a validity checker's compiled view, as OMPL checks a motion: the end
+  information; or a validator that says it ``checks_as_discrete``) around a validity checker's compiled view, as OMPL checks a motion: the end
   state first, then the states at ``j / n`` of the way, ``n = validSegmentCount``, in
   breadth-first bisection order;
 * :class:`PythonChecks`: anything else (a user's Python callable, a C++ checker, a motion
@@ -97,11 +97,13 @@ class EngineChecks:
 def checks_for(si: ob.SpaceInformation, layout: SpaceLayout) -> EngineChecks:
     """The check view the compiled engine uses for ``si``'s validity checker and motion validator."""
     checker, validator = si.getStateValidityChecker(), si.getMotionValidator()
-    view_of = getattr(validator, "compiled_view", None)
-    if view_of is not None:
-        return EngineChecks(view_of(), "kernel")
+    motions = getattr(validator, "compiled_view", lambda: None)()
+    if motions is not None:
+        return EngineChecks(motions, "kernel")
     states = getattr(checker, "compiled_view", lambda: None)()
-    if states is not None and type(validator) is ob.MotionValidator:  # OMPL's own DiscreteMotionValidator
+    # OMPL's own DiscreteMotionValidator, or one that checks the same states
+    discrete = type(validator) is ob.MotionValidator or getattr(validator, "checks_as_discrete", False)
+    if states is not None and discrete:
         # room for OMPL's bisection queue of a motion across the whole space
         longest = max(int(f) * math.ceil(si.getMaximumExtent() / g) for f, g in zip(layout.factor, layout.segment))
         queue = np.empty((2 * longest + 4, 2), dtype=np.int64)

@@ -43,6 +43,7 @@ from ..environment import Environment
 from ..geometry import Shape, fcl_transform
 from .advance import LAST_VALID_TRAVEL, MIN_TRAVEL, edge_status
 from .body import RigidBody
+from .kernels import RigidStates, rigid_states
 from .motion import interpolate, motion_split, state_pose, valid_state
 from .pieces import soup_mesh
 from .view import (
@@ -268,6 +269,11 @@ class RigidBodyChecker:
     def inside_bounds(self, state: ArrayLike) -> bool:
         """Whether ``state`` is a valid state within the position bounds (collisions aside)."""
         return bool(valid_state(self._row(state), self.view.low, self.view.high))
+
+    def kernel_view(self) -> RigidStates | None:
+        """The checker as compiled code sees it (:class:`~ompl_balance.collision.rigid.kernels.RigidStates`),
+        or ``None`` without ``prefilter`` (the reference path is Python's)."""
+        return rigid_states(self) if self.prefilter else None
 
     def counters(self) -> dict[str, int]:
         return self.counter.counters()
