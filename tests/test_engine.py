@@ -429,15 +429,37 @@ def test_ctrl_c_interrupts_a_compiled_solve():
             print("interrupted", planner.stats is None or planner.stats.iterations, flush=True)
         """
     )
-    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
     assert process.stdout is not None
     assert process.stdout.readline().strip() == "solving"
     time.sleep(1.0)
     process.send_signal(signal.SIGINT)
     began = time.perf_counter()
-    out, _ = process.communicate(timeout=30)
-    assert "interrupted" in out
+    out, err = process.communicate(timeout=30)
+    assert "interrupted" in out, err[-3000:]
     assert time.perf_counter() - began < 10.0
+
+
+def test_ctrl_c_in_a_compiled_slice_is_raised_between_slices_not_inside_it():
+    """SIGINT during a slice (where Python code runs only inside a kernel's exit) sets a flag; the
+    driver raises KeyboardInterrupt between slices, and at the end if it came in the last one."""
+    import os
+
+    from ompl_balance.engine.driver import interrupts_between_slices
+
+    with pytest.raises(KeyboardInterrupt), interrupts_between_slices() as raise_interrupt:
+        raise_interrupt()  # nothing came yet
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.01)  # Python runs the handler here: no exception yet
+        reached = True
+        raise_interrupt()
+    assert reached
+    with pytest.raises(KeyboardInterrupt), interrupts_between_slices():
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.01)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
 
 
 def test_a_fresh_processs_first_half_second_solve_returns_in_time():

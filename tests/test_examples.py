@@ -29,7 +29,13 @@ runpy.run_path(script, run_name="__main__")
 
 
 def test_every_example_is_covered():
-    assert SCRIPTS == ["balanced_rrtc_2d.py", "ball_radius_constant.py", "panda_table.py", "variants_2d.py"]
+    assert SCRIPTS == [
+        "balanced_rrtc_2d.py",
+        "ball_radius_constant.py",
+        "panda_table.py",
+        "rigid_body.py",
+        "variants_2d.py",
+    ]
 
 
 @pytest.mark.parametrize("script", SCRIPTS)

@@ -3,7 +3,7 @@
 :func:`run` prepares the arrays :func:`ompl_balance.engine.loop.run` works in (the
 planner's own trees, grown in place), then calls it in slices of iterations, adapting the
 slice so that one lasts about a millisecond: between slices it polls the termination
-condition (and Python raises a pending ``KeyboardInterrupt``), and it acts on why the
+condition (and raises ``KeyboardInterrupt`` after a Ctrl-C), and it acts on why the
 slice stopped: a goal state to feed (OMPL's ``PlannerInputStates``), room to make in the
 trees, a connection for the goal to accept. At the end the planner's trees, swap state,
 counts and loop record hold what the compiled loop did, as if the Python engine had run.
@@ -11,8 +11,11 @@ counts and loop record hold what the compiled loop did, as if the Python engine 
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
@@ -142,6 +145,34 @@ def _grown(array: np.ndarray, rows: int) -> np.ndarray:
     return grown
 
 
+@contextlib.contextmanager
+def interrupts_between_slices() -> Iterator[Callable[[], None]]:
+    """Ctrl-C during a compiled solve, raised between slices: yields ``check()``, which raises
+    ``KeyboardInterrupt`` if SIGINT came since the last call.
+
+    Python raises ``KeyboardInterrupt`` wherever its interpreter next runs, which in a compiled
+    slice is inside a kernel's ``objmode`` exit to Python; numba does not carry an exception out
+    of there safely (a process could crash). So while the solve runs, SIGINT only sets a flag
+    (main thread only: Python delivers signals there; elsewhere nothing changes).
+    """
+    caught: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: None
+        return
+
+    def check() -> None:
+        if caught:
+            caught.clear()
+            raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
+    try:
+        yield check
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        check()  # a SIGINT in the last slice
+
+
 def run(
     solve: Solve, ptc: ob.PlannerTerminationCondition, checks: EngineChecks, layout: SpaceLayout, room: int
 ) -> ob.PlannerStatus.PlannerStatusType:
@@ -158,34 +189,36 @@ def run(
     status = ob.PlannerStatus.TIMEOUT
     budget = 1
     run_slice = _runner(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
-    try:
-        while not ptc():
-            ints[Slot.SAMPLED_GOALS] = solve.inputs.getSampledGoalsCount()
-            ints[Slot.MORE_GOALS] = solve.inputs.haveMoreGoalStates()
-            began = time.perf_counter()
-            stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
-            arrays.adopt()
-            solve.progress.iterations = int(ints[Slot.ITERATIONS])
-            if stop == Stop.BUDGET:
-                elapsed = time.perf_counter() - began
-                if elapsed < 0.25 * SLICE_SECONDS:
-                    budget = min(2 * budget, MAX_BUDGET)
-                elif elapsed > 2.0 * SLICE_SECONDS:
-                    budget = max(1, budget // 2)
-            elif stop == Stop.NEED_ROOM:
-                arrays.trees = arrays.make_room()
-            elif stop == Stop.NEED_GOAL:
-                if not solve.feed_goal(ptc):
-                    status = ob.PlannerStatus.INVALID_GOAL
+    with interrupts_between_slices() as raise_interrupt:
+        try:
+            while not ptc():
+                ints[Slot.SAMPLED_GOALS] = solve.inputs.getSampledGoalsCount()
+                ints[Slot.MORE_GOALS] = solve.inputs.haveMoreGoalStates()
+                began = time.perf_counter()
+                stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
+                arrays.adopt()
+                raise_interrupt()
+                solve.progress.iterations = int(ints[Slot.ITERATIONS])
+                if stop == Stop.BUDGET:
+                    elapsed = time.perf_counter() - began
+                    if elapsed < 0.25 * SLICE_SECONDS:
+                        budget = min(2 * budget, MAX_BUDGET)
+                    elif elapsed > 2.0 * SLICE_SECONDS:
+                        budget = max(1, budget // 2)
+                elif stop == Stop.NEED_ROOM:
+                    arrays.trees = arrays.make_room()
+                elif stop == Stop.NEED_GOAL:
+                    if not solve.feed_goal(ptc):
+                        status = ob.PlannerStatus.INVALID_GOAL
+                        break
+                    arrays.trees = arrays.make_room()
+                    ints[Slot.GOAL_FED] = 1
+                elif solve.accept(int(ints[Slot.START_NODE]), int(ints[Slot.GOAL_NODE])):
+                    status = ob.PlannerStatus.EXACT_SOLUTION
                     break
-                arrays.trees = arrays.make_room()
-                ints[Slot.GOAL_FED] = 1
-            elif solve.accept(int(ints[Slot.START_NODE]), int(ints[Slot.GOAL_NODE])):
-                status = ob.PlannerStatus.EXACT_SOLUTION
-                break
-    finally:
-        arrays.adopt()
-        _report(solve, arrays, settings, int(checks.view.counts[Count.EXITS]) - exits_before)
+        finally:
+            arrays.adopt()
+            _report(solve, arrays, settings, int(checks.view.counts[Count.EXITS]) - exits_before)
     return status
 
 
