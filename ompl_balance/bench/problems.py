@@ -78,6 +78,26 @@ class ProblemKind:
     scenarios: bool = False  # named SCENARIO.NNN: summaries also pool each scenario's problems
 
 
+def shipped_or_file(
+    table: Mapping[str, Any], key: str, shipped: Sequence[str], what: str, where: str, base_dir: Path
+) -> str:
+    """``table[key]`` when it names one of ``shipped``, else the absolute path of the file it
+    names relative to the experiment file; :class:`ExperimentError` when it is neither."""
+    source = table[key]
+    if not isinstance(source, str):
+        raise ExperimentError(f"{where}.{key}", f"must be a shipped {what}'s name or a file", source)
+    if source in shipped:
+        return source
+    path = (base_dir / source).resolve()
+    if not path.is_file():
+        raise ExperimentError(
+            f"{where}.{key}",
+            f"{source!r} is neither a shipped {what} ({', '.join(shipped)}) nor a file (looked for {str(path)!r})",
+            source,
+        )
+    return str(path)
+
+
 # -- built-in 2-D problems ----------------------------------------------------------------
 
 
@@ -162,17 +182,7 @@ def _read_mbm(table: Mapping[str, Any], where: str, base_dir: Path) -> list[Prob
     from ..validity import MOTION_VALIDATORS
     from ..worlds.mbm import SCENARIOS, load_mbm
 
-    source = str(table["mbm"])
-    if source not in SCENARIOS:  # a file, relative to the experiment file
-        path = (base_dir / source).resolve()
-        if not path.is_file():
-            raise ExperimentError(
-                f"{where}.mbm",
-                f"{source!r} is neither a shipped scenario ({', '.join(SCENARIOS)}) "
-                f"nor a file (looked for {str(path)!r})",
-                table["mbm"],
-            )
-        source = str(path)
+    source = shipped_or_file(table, "mbm", SCENARIOS, "scenario", where, base_dir)
     robot = ""  # the Panda shipped with the package
     if "robot" in table:
         robot = str((base_dir / table["robot"]).resolve())
@@ -241,23 +251,13 @@ def _read_rigid(table: Mapping[str, Any], where: str, base_dir: Path) -> list[Pr
     from ..worlds.omplapp import load_omplapp
     from ..worlds.rigid import RIGID_PROBLEMS
 
-    source, data = table["rigid"], ""
-    if not isinstance(source, str):
-        raise ExperimentError(f"{where}.rigid", "must be a shipped problem's name or an OMPL.app .cfg file", source)
-    if source not in RIGID_PROBLEMS:  # an OMPL.app problem file, relative to the experiment file
-        path = (base_dir / source).resolve()
-        if not path.is_file():
-            raise ExperimentError(
-                f"{where}.rigid",
-                f"{source!r} is neither a shipped problem ({', '.join(RIGID_PROBLEMS)}) "
-                f"nor a file (looked for {str(path)!r})",
-                source,
-            )
+    source, data = shipped_or_file(table, "rigid", RIGID_PROBLEMS, "problem", where, base_dir), ""
+    if source not in RIGID_PROBLEMS:  # an OMPL.app problem file
         try:
-            load_omplapp(path, validate=False)
+            load_omplapp(source, validate=False)
         except ValueError as error:
-            raise ExperimentError(f"{where}.rigid", str(error), source) from error
-        source, data = str(path), files_digest([path])
+            raise ExperimentError(f"{where}.rigid", str(error), table["rigid"]) from error
+        data = files_digest([Path(source)])
     motion = table.get("motion", "certified")
     if motion not in MOTION_VALIDATORS:
         raise ExperimentError(

@@ -225,7 +225,7 @@ def table_span_free(
 
 
 @njit(cache=True)
-def _grow(array: np.ndarray, size: int) -> np.ndarray:  # pragma: no cover (compiled)
+def grown(array: np.ndarray, size: int) -> np.ndarray:  # pragma: no cover (compiled)
     """``array``, or a copy at least twice as long when it is shorter than ``size``."""
     if len(array) >= size:
         return array
@@ -437,8 +437,8 @@ def advance(
             if seg_lower[e, 0] + seg_lower[e, 1] > need or t0 >= bad:
                 continue
             if not model.solid[pair] and travel <= handover:
-                hard_pair = _grow(hard_pair, hard + 1)
-                hard_span = _grow(hard_span, hard + 1)
+                hard_pair = grown(hard_pair, hard + 1)
+                hard_span = grown(hard_span, hard + 1)
                 hard_pair[hard] = pair
                 hard_span[hard, 0], hard_span[hard, 1] = t0, t0 + width
                 hard_span[hard, 2], hard_span[hard, 3] = seg_lower[e, 0], seg_lower[e, 1]
@@ -468,8 +468,8 @@ def advance(
             while last < splits and seg_k[order[last]] == k:
                 last += 1
             points += 1
-            point_t = _grow(point_t, points)
-            point_poses = _grow(point_poses, points)
+            point_t = grown(point_t, points)
+            point_poses = grown(point_poses, points)
             middle = points - 1
             point_t[middle] = (k + 0.5) * width
             for j in range(dof):

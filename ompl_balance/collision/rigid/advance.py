@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit, types
 from numba.typed import Dict
 
-from ..advancement import DISTANCE_TOLERANCE
+from ..advancement import DISTANCE_TOLERANCE, grown
 from .motion import interpolate, motion_split, state_pose, valid_state
 from .view import (
     BOUNDS_COMPUTED,
@@ -50,16 +50,6 @@ MIN_TRAVEL = 1e-7
 #: Travel (times the view's scale) to which ``last_valid`` refines around the first failure
 #: before it reports the certified fraction.
 LAST_VALID_TRAVEL = 1e-3
-
-
-@njit(cache=True)
-def _grow(array: np.ndarray, size: int) -> np.ndarray:  # pragma: no cover (compiled)
-    """``array``, or a copy at least twice as long when it is shorter than ``size``."""
-    if len(array) >= size:
-        return array
-    bigger = np.empty((max(size, 2 * len(array)), *array.shape[1:]), dtype=array.dtype)
-    bigger[: len(array)] = array
-    return bigger
 
 
 @njit(cache=True)
@@ -173,17 +163,17 @@ def edge_status(
         middle = 0.5 * (t0 + t1)
         if middle not in known:
             index = len(known)
-            point_t = _grow(point_t, index + 1)
-            point_pose = _grow(point_pose, index + 1)
+            point_t = grown(point_t, index + 1)
+            point_pose = grown(point_pose, index + 1)
             interpolate(a, b, middle, state)
             state_pose(state, point_pose[index])
             point_t[index] = middle
             known[middle] = index
         m = known[middle]
         dm = sphere_bound(view, point_pose[m], pair)
-        seg_pair = _grow(seg_pair, tail + 2)
-        seg_t, seg_d = _grow(seg_t, tail + 2), _grow(seg_d, tail + 2)
-        seg_final, seg_point = _grow(seg_final, tail + 2), _grow(seg_point, tail + 2)
+        seg_pair = grown(seg_pair, tail + 2)
+        seg_t, seg_d = grown(seg_t, tail + 2), grown(seg_d, tail + 2)
+        seg_final, seg_point = grown(seg_final, tail + 2), grown(seg_point, tail + 2)
         for side in range(2):
             child = tail + side
             seg_pair[child] = pair
