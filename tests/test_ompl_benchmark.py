@@ -38,7 +38,7 @@ def test_the_log_of_ompls_benchmark_holds_the_package_planners_parameters_and_gr
             )
             graphs.setdefault(planner.getName(), []).append((trees, stats.iterations))
 
-    request = ot.Request(0.5, 1000.0, RUNS)
+    request = ot.Request(0.5, 1000.0, RUNS, 0.05, True, False, True)  # no .console file in the cwd
     request.displayProgress = False
     run_ompl_benchmark(benchmark, request, post_run=post_run)
     log = tmp_path / "filled.log"
