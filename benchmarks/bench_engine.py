@@ -1,7 +1,9 @@
 """The compiled engine against the Python engine and stock OMPL, measured in one run.
 
 Three parts (``--part``), each printing a table of medians and ratios measured in the same
-run, planners interleaved run by run so that the machine's slow phases hit all of them:
+run, planners interleaved run by run so that the machine's slow phases hit all of them. The
+two engines get the same seed in each run, so they make the same trees: their time ratio is
+the engines' speed alone.
 
 ``panda``
     MotionBenchMaker Panda problems (the four shipped scenarios, the first ``--problems`` of
@@ -22,8 +24,13 @@ run, planners interleaved run by run so that the machine's slow phases hit all o
     checks in compiled code (the edges and states of the same runs, replayed through the
     kernels), the calls out to Python (FCL on pairs the kernels cannot decide, timed), and the
     rest (the loop: nearest nodes, sampling, trees; slices and their Python).
+``scaling``
+    The cost of an iteration as the trees grow to tens of thousands of nodes, in R^2 and SE(3)
+    (a box world and a rigid body, each cut in two by a wall so that both trees grow freely
+    and never meet): solves of increasing length on one seed, each repeating the shorter ones,
+    so the difference of two is the cost of the iterations between them.
 
-Run: ``python benchmarks/bench_engine.py [--part panda,2d,profile] [--problems 25] [--runs 1]``
+Run: ``python benchmarks/bench_engine.py [--part panda,2d,profile,scaling] [--problems 25] [--runs 1]``
 """
 
 from __future__ import annotations
@@ -44,23 +51,26 @@ from ompl import util as ou
 from ompl_balance import BalancedRRTConnect
 from ompl_balance.collision import certified
 from ompl_balance.collision.checker import CollisionChecker
+from ompl_balance.collision.environment import Environment
 from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.core.counting import CountingValidityChecker, measured_solve
-from ompl_balance.worlds.boxes import BoxWorld2D, get_problem
+from ompl_balance.worlds.boxes import BoxWorld2D, Problem, get_problem
 from ompl_balance.worlds.mbm import SCENARIOS, MBMProblem, load_mbm
+from ompl_balance.worlds.rigid import RigidBodyProblem, shipped_robot
 
 ENGINES = ("python", "compiled")
 KEYS = ("time", "iterations", "checks", "motions", "exits")
 
 
-def stock(si):
-    return og.RRTConnect(si)
+def stock(si, seed: int):
+    return og.RRTConnect(si)  # (OMPL's random numbers: seeded once per process only)
 
 
 def balanced(engine: str) -> Callable:
-    def make(si):
+    def make(si, seed: int):
         planner = BalancedRRTConnect(si)
         planner.setEngine(engine)
+        planner.setSeed(seed)
         return planner
 
     return make
@@ -69,9 +79,9 @@ def balanced(engine: str) -> Callable:
 PLANNERS = {"RRTConnect": stock, **{f"BalancedRRTConnect[{engine}]": balanced(engine) for engine in ENGINES}}
 
 
-def measure(ss, make_planner, time_limit: float) -> dict:
+def measure(ss, make_planner, time_limit: float, seed: int) -> dict:
     """One solve of ``ss`` (set up outside the timing) and its work."""
-    planner = make_planner(ss.getSpaceInformation())
+    planner = make_planner(ss.getSpaceInformation(), seed)
     ss.setPlanner(planner)
     run = measured_solve(ss, time_limit)
     stats = getattr(planner, "stats", None)
@@ -130,10 +140,10 @@ def panda(args) -> None:
     for scenario in SCENARIOS:
         rows: dict[str, list[dict]] = {name: [] for name in PLANNERS}
         for problem in load_mbm(scenario, robot.joint_names)[: args.problems]:
-            for _ in range(args.runs):
+            for run in range(args.runs):
                 for name, make in PLANNERS.items():
                     ss = problem.simple_setup(robot, CollisionChecker(robot, problem.environment))
-                    rows[name].append(measure(ss, make, args.time_limit))
+                    rows[name].append(measure(ss, make, args.time_limit, seed=1 + problem.id + 1000 * run))
                     if name == "BalancedRRTConnect[compiled]" and rows[name][-1]["solved"]:
                         path = ss.getSolutionPath()
                         states = np.array([path.getState(i)[0 : robot.dof] for i in range(path.getStateCount())])
@@ -167,9 +177,9 @@ def two_d(args) -> None:
     cases["bug_trap (Python callable)"] = bug_trap_callable_setup
     for label, make_setup in cases.items():
         rows: dict[str, list[dict]] = {name: [] for name in PLANNERS}
-        for _ in range(args.runs_2d):
+        for run in range(args.runs_2d):
             for name, make in PLANNERS.items():
-                rows[name].append(measure(make_setup(), make, TIME_LIMIT_2D))
+                rows[name].append(measure(make_setup(), make, TIME_LIMIT_2D, seed=1 + run))
         table(rows, label)
 
 
@@ -242,6 +252,7 @@ def profile_problem(robot, problem: MBMProblem, time_limit: float, replay: Calla
     certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))  # (the view's exits)
     view = certifier.compiled_view()
     starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
+    replay(view, starts[:0], ends[:0], np.empty((0, robot.dof)))  # compiled before the timing
     with timed_exits() as spent:
         began = time.perf_counter()
         replay(view, starts, ends, np.array(states).reshape(-1, robot.dof))
@@ -283,9 +294,60 @@ def profile(args) -> None:
         )
 
 
+def split_box_world() -> Callable[[], og.SimpleSetup]:
+    """The unit square cut in two by a wall: start and goal on either side, both trees grow freely."""
+    return Problem("split", "a wall between start and goal", ((0.48, 0.0, 0.52, 1.0),), (0.1, 0.5), (0.9, 0.5)).setup
+
+
+def split_room() -> Callable[[], og.SimpleSetup]:
+    """An SE(3) room cut in two by a wall, the L-shaped robot on either side (certified motions)."""
+    environment = Environment()
+    environment.add_box("wall", (0.1, 4.0, 4.0), (0.0, 0.0, 0.0))
+    identity = (0.0, 0.0, 0.0, 1.0)
+    problem = RigidBodyProblem(
+        "split_room", shipped_robot("ell"), environment, np.array([-2.0, 0.0, 0.0, *identity]),
+        np.array([2.0, 0.0, 0.0, *identity]), np.full(3, -4.0), np.full(3, 4.0),
+    )  # fmt: skip
+    return problem.simple_setup
+
+
+#: Solve lengths (s) of the scaling part: the same seed each time, so each solve repeats the shorter ones.
+SCALING_LIMITS = (0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 4.0)
+
+
+def scaling(args) -> None:
+    """The cost of an iteration as the trees grow (see the module docstring)."""
+    print("\nCost of an iteration as the trees grow (BalancedRRTConnect, compiled engine, one seed)\n")
+    print(
+        "| problem | nodes (both trees) | iterations | us / iteration between the two | states checked / iteration |"
+        "\n|---|---|---|---|---|"
+    )
+    for label, make_setup in (("R^2, a wall across", split_box_world()), ("SE(3), a wall across", split_room())):
+        previous, costs = (0, 0, 0.0, 0), []  # (iterations, nodes, seconds, checks) of the solve before
+        for limit in SCALING_LIMITS:
+            ss = make_setup()
+            planner = BalancedRRTConnect(ss.getSpaceInformation())
+            planner.setEngine("compiled")
+            planner.setSeed(7)
+            ss.setPlanner(planner)
+            run = measured_solve(ss, limit)
+            elapsed, checks = run.time, run.work.states_checked
+            iterations, nodes = planner.stats.iterations, planner.stats.start_tree_size + planner.stats.goal_tree_size
+            cost = (elapsed - previous[2]) / max(iterations - previous[0], 1) * 1e6
+            checks_each = (checks - previous[3]) / max(iterations - previous[0], 1)
+            if previous[1] >= 100 and nodes <= 20_000:  # (the first solve's cost includes the solve's own)
+                costs.append(cost)
+            print(f"| {label} | {previous[1]} to {nodes} | {iterations} | {cost:.1f} | {checks_each:.1f} |", flush=True)
+            previous = (iterations, nodes, elapsed, checks)
+        if costs:
+            print(f"| {label} | 100 to 20,000: most / least cost per iteration | | {max(costs) / min(costs):.2f} | |")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--part", default="panda,2d,profile", help="comma-separated parts: panda, 2d, profile")
+    parser.add_argument(
+        "--part", default="panda,2d,profile,scaling", help="comma-separated parts: panda, 2d, profile, scaling"
+    )
     parser.add_argument("--problems", type=int, default=25, help="Panda problems per scenario (default 25)")
     parser.add_argument("--runs", type=int, default=1, help="Panda runs per problem and planner (default 1)")
     parser.add_argument("--runs-2d", type=int, default=30, help="2-D runs per problem and planner (default 30)")
@@ -300,7 +362,7 @@ def main() -> None:
         f"{platform.python_version()}, ompl {metadata.version('ompl')}; compiled engine loaded before timing\n"
     )
     for part in args.part.split(","):
-        {"panda": panda, "2d": two_d, "profile": profile}[part](args)
+        {"panda": panda, "2d": two_d, "profile": profile, "scaling": scaling}[part](args)
     print(f"\nwhole script: {time.perf_counter() - began:.0f} s; median of runs, ratios of medians")
 
 

@@ -300,7 +300,7 @@ class BalancedRRTConnect(TreePlanner):
         si = self.getSpaceInformation()
         layout = layout_for(si.getStateSpace())
         assert layout is not None  # (checked by _why_not_compiled)
-        load_engine(si, layout, wait=wait)
+        load_engine(si, layout, self.settings.engine, wait=wait)
 
     def _check_policies(self) -> None:
         """Refuse combinations of policies and parameters that cannot do what they say."""
@@ -466,7 +466,7 @@ class BalancedRRTConnect(TreePlanner):
                     f"{room} nodes; use a larger range or engine=python"
                 )
             return None
-        return prepared(solve, points.layout, room, wait=settings.engine == "compiled", name=self.getName())
+        return prepared(solve, points.layout, room, settings.engine, self.getName())
 
     def _progress_extras(self) -> dict[str, Callable[[], str]]:
         return {

@@ -167,11 +167,23 @@ def _console_script() -> str:
     return str(Path(sys.executable).with_name("ompl-balance"))
 
 
+def _with_ctrl_c_as_in_a_terminal(command: list[str]) -> list[str]:
+    """``command``, started with SIGINT's default action, as a terminal's foreground job has it
+    (a test suite run as a background job passes "ignore" on, and Python then never raises
+    KeyboardInterrupt): a Python stub resets it and replaces itself with ``command``."""
+    stub = "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); os.execv(sys.argv[1], sys.argv[1:])"
+    return [sys.executable, "-c", stub, *command]
+
+
 def test_compare_interrupted_then_run_again_resumes(tmp_path):
     out = tmp_path / "out"
     command = [_console_script(), "compare", "--problems", "open", "--runs", "20", "-o", str(out), "--no-progress"]
     compare = subprocess.Popen(
-        command, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+        _with_ctrl_c_as_in_a_terminal(command),
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     results = out / "results.jsonl"
     deadline = time.monotonic() + 120

@@ -84,7 +84,7 @@ class Remembered(NamedTuple):
     final: np.ndarray
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _placed(poses: np.ndarray, body: int, points: np.ndarray, i: int) -> Vector:  # pragma: no cover (compiled)
     """Body-frame point ``points[i]`` (3,) in the world, for the body at ``poses[body]`` (4, 4)."""
     x, y, z = points[i, 0], points[i, 1], points[i, 2]
@@ -95,7 +95,7 @@ def _placed(poses: np.ndarray, body: int, points: np.ndarray, i: int) -> Vector:
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sphere_bounds(
     poses: np.ndarray, volumes: Volumes, model: Model, pairs: np.ndarray, out: np.ndarray
 ) -> None:  # pragma: no cover (compiled)
@@ -136,7 +136,7 @@ def sphere_bounds(
             out[i] = between - volumes.outer_radius[first] - volumes.outer_radius[second] - SLACK
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def hull_bounds(
     pair: int, poses: np.ndarray, volumes: Volumes, model: Model, warm: np.ndarray, identity: np.ndarray, enough: float
 ) -> tuple[float, float]:  # pragma: no cover (compiled)
@@ -173,7 +173,7 @@ def hull_bounds(
     return lower - SLACK, upper
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def table_span_free(
     a: np.ndarray, delta: np.ndarray, t0: float, t1: float, chain: Chain, volumes: Volumes, table: int
 ) -> bool:  # pragma: no cover (compiled)

@@ -29,7 +29,7 @@ def register_kernels(view_class: type, state: Any = None, motion: Any = None) ->
 
             return implementation
 
-        overload(state_free)(state_typing)
+        overload(state_free, inline="always")(state_typing)
     if motion is not None:
 
         def motion_typing(view: Any, a: Any, b: Any) -> Any:
@@ -41,4 +41,4 @@ def register_kernels(view_class: type, state: Any = None, motion: Any = None) ->
 
             return implementation
 
-        overload(motion_free)(motion_typing)
+        overload(motion_free, inline="always")(motion_typing)

@@ -122,11 +122,15 @@ def segment_count(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> int:  # 
     return count
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def interpolate(
     layout: SpaceLayout, a: np.ndarray, b: np.ndarray, t: float, out: np.ndarray
 ) -> None:  # pragma: no cover
-    """Write the state a fraction ``t`` of the way from ``a`` to ``b`` (OMPL's interpolation) into ``out``."""
+    """Write the state a fraction ``t`` of the way from ``a`` to ``b`` (OMPL's interpolation) into ``out``.
+
+    Inlined where it is called: a call that passes the layout's arrays costs more than the
+    interpolation itself (some 150 ns against a few for a real-vector state).
+    """
     for leaf in range(len(layout.kind)):
         start, size = layout.offset[leaf], layout.size[leaf]
         kind = layout.kind[leaf]

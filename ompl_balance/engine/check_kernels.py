@@ -11,7 +11,7 @@ from ..core.compiled_spaces import interpolate, segment_count
 from .views import DiscreteMotions, PythonChecks, call_check_motion, call_is_valid
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """OMPL's ``DiscreteMotionValidator::checkMotion(s1, s2)``: ``b`` first, then the states
     ``a + (j / n) (b - a)`` in the order of its queue of index ranges (the middle of each
@@ -59,7 +59,7 @@ def _python_motion_free(view: PythonChecks, a: np.ndarray, b: np.ndarray) -> boo
     return free
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _discrete_state_free(view: DiscreteMotions, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
     return state_free(view.states, q)
 

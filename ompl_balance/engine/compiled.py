@@ -72,13 +72,26 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
             warm_exits()
 
 
-def load(si: ob.SpaceInformation, layout: SpaceLayout, wait: bool) -> None:
-    """Start loading the compiled engine for ``si``'s checks in the background, or (``wait``) load it now.
+def runs_compiled(checks: EngineChecks, engine: str) -> bool:
+    """Whether ``engine`` (``"auto"`` or ``"compiled"``) plans on the compiled engine with ``checks``.
+
+    ``auto`` keeps the Python engine where every check is a call to Python (``checks.path ==
+    "python"``: a user's callable, a C++ checker): such a call made from compiled code costs
+    more than the compiled loop saves around it.
+    """
+    return engine == "compiled" or checks.path == "kernel"
+
+
+def load(si: ob.SpaceInformation, layout: SpaceLayout, engine: str, wait: bool) -> None:
+    """Start loading the compiled engine for ``si``'s checks in the background, or (``wait``) load
+    it now, where ``engine`` would plan on it (:func:`runs_compiled`).
 
     Planners call this from ``setup()``: ``SimpleSetup.solve`` sets up before the solve's
     time limit starts, so a wait here (``engine=compiled``) does not eat into the solve.
     """
     checks = checks_for(si, layout)
+    if not runs_compiled(checks, engine):
+        return
     key = view_key((checks.view, layout))
     warm = partial(_warm, checks.view, layout)
     if wait:
@@ -103,13 +116,17 @@ def _compile_lock() -> Iterator[None]:
             fcntl.flock(lock, fcntl.LOCK_UN)
 
 
-def prepared(solve: Solve, layout: SpaceLayout, room: int, wait: bool, name: str) -> CompiledRun | None:
-    """The compiled engine's run of ``solve`` if it is ready (``wait``: made ready now), else ``None``."""
+def prepared(solve: Solve, layout: SpaceLayout, room: int, engine: str, name: str) -> CompiledRun | None:
+    """The compiled engine's run of ``solve`` where ``engine`` plans on it (:func:`runs_compiled`)
+    and it is ready (``engine="compiled"``: made ready now), else ``None``."""
     checks = checks_for(solve.si, layout)
+    if not runs_compiled(checks, engine):
+        return None
     key = view_key((checks.view, layout))
-    if wait:
+    ready = LOADER.ready(key)
+    if engine == "compiled" and not ready:
         LOADER.wait(key, partial(_warm, checks.view, layout), _describe(checks))
-    elif not LOADER.ready(key):
+    elif not ready:
         failure = LOADER.failure(key)
         if failure is None:
             if LOADER.start(key, partial(_warm, checks.view, layout)):

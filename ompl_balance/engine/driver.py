@@ -1,10 +1,9 @@
 """The Python side of the compiled engine: one solve, in slices between which Python acts.
 
 :func:`run` prepares the arrays :func:`ompl_balance.engine.loop.run` works in (the
-planner's own trees, grown in place), then calls it in slices of iterations, adapting the
-slice so that one lasts about a millisecond: between slices it polls the termination
-condition (and raises ``KeyboardInterrupt`` after a Ctrl-C), and it acts on why the
-slice stopped: a goal state to feed (OMPL's ``PlannerInputStates``), room to make in the
+planner's own trees, grown in place), then calls it in slices of about two milliseconds
+(the loop reads its own clock): between slices it polls the termination condition (and
+raises ``KeyboardInterrupt`` after a Ctrl-C), and it acts on why the slice stopped: a goal state to feed (OMPL's ``PlannerInputStates``), room to make in the
 trees, a connection for the goal to accept. At the end the planner's trees, swap state,
 counts and loop record hold what the compiled loop did, as if the Python engine had run.
 """
@@ -14,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import signal
 import threading
-import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -35,11 +33,9 @@ from .loop import Real, Record, Slot, Stop
 from .solve import Solve
 from .views import EngineChecks
 
-#: A slice of iterations lasts about this long (s): the termination condition's polling period
-#: (a slice costs some 50 microseconds of Python around it).
-SLICE_SECONDS = 2e-3
-#: Iterations of the largest slice.
-MAX_BUDGET = 1 << 16
+#: A slice of iterations lasts this long (ns, and the iteration under way at its end): the
+#: termination condition's polling period (a slice costs some 20 microseconds of Python around it).
+SLICE_NS = 2_000_000
 
 
 def settings_of(solve: Solve) -> loop.Settings:
@@ -187,25 +183,17 @@ def run(
     reals[Real.TREE_GAP] = solve.tree_gap
     exits_before = int(checks.view.counts[Count.EXITS])
     status = ob.PlannerStatus.TIMEOUT
-    budget = 1
-    run_slice = _runner(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
+    run_slice = _runner(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, SLICE_NS)
     with interrupts_between_slices() as raise_interrupt:
         try:
             while not ptc():
                 ints[Slot.SAMPLED_GOALS] = solve.inputs.getSampledGoalsCount()
                 ints[Slot.MORE_GOALS] = solve.inputs.haveMoreGoalStates()
-                began = time.perf_counter()
-                stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, budget)
+                stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, SLICE_NS)
                 arrays.adopt()
                 raise_interrupt()
                 solve.progress.iterations = int(ints[Slot.ITERATIONS])
-                if stop == Stop.BUDGET:
-                    elapsed = time.perf_counter() - began
-                    if elapsed < 0.25 * SLICE_SECONDS:
-                        budget = min(2 * budget, MAX_BUDGET)
-                    elif elapsed > 2.0 * SLICE_SECONDS:
-                        budget = max(1, budget // 2)
-                elif stop == Stop.NEED_ROOM:
+                if stop == Stop.NEED_ROOM:
                     arrays.trees = arrays.make_room()
                 elif stop == Stop.NEED_GOAL:
                     if not solve.feed_goal(ptc):
@@ -213,7 +201,7 @@ def run(
                         break
                     arrays.trees = arrays.make_room()
                     ints[Slot.GOAL_FED] = 1
-                elif solve.accept(int(ints[Slot.START_NODE]), int(ints[Slot.GOAL_NODE])):
+                elif stop == Stop.CONNECTED and solve.accept(int(ints[Slot.START_NODE]), int(ints[Slot.GOAL_NODE])):
                     status = ob.PlannerStatus.EXACT_SOLUTION
                     break
         finally:

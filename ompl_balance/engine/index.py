@@ -153,21 +153,31 @@ def _build(index: KDIndex, states: np.ndarray, size: int) -> None:  # pragma: no
 
 @njit(cache=True, inline="always")
 def _key(
-    layout: SpaceLayout, euclidean: bool, states: np.ndarray, node: int, query: np.ndarray, index: KDIndex, best: float
+    layout: SpaceLayout,
+    euclidean: bool,
+    states: np.ndarray,
+    node: int,
+    query: np.ndarray,
+    offset: int,
+    axes: int,
+    weight: float,
+    best: float,
 ) -> float:  # pragma: no cover (compiled)
     """What nodes are compared by: the squared distance (Euclidean spaces, as the scan compares)
-    or the distance, computed in full only when the position's share alone is not above ``best``."""
+    or the distance, computed in full only when the position's share alone (coordinates
+    ``offset .. offset + axes``, weight ``weight``) is not above ``best``. (Scalars rather
+    than the index: passing its arrays costs more, per node, than the distance.)"""
     if euclidean:
         squared = 0.0
         for k in range(query.shape[0]):
-            offset = states[node, k] - query[k]
-            squared += offset * offset
+            gap = states[node, k] - query[k]
+            squared += gap * gap
         return squared
-    offset, squared = index.ints[Setting.OFFSET], 0.0
-    for k in range(offset, offset + index.ints[Setting.AXES]):
+    squared = 0.0
+    for k in range(offset, offset + axes):
         gap = states[node, k] - query[k]
         squared += gap * gap
-    share = index.weight[0] * np.sqrt(squared)
+    share = weight * np.sqrt(squared)
     return share if share > best else row_distance(layout, states, node, query)
 
 
@@ -185,14 +195,13 @@ def indexed_nearest(
         _build(index, states, size)
         built = size
     euclidean = is_euclidean(layout)  # then keys are squared distances, and so are the bounds
-    weight = index.weight[0]
+    weight, axes = index.weight[0], index.ints[Setting.AXES]
     best, best_key = NONE, np.inf
     for node in range(built, size):  # added since the build
-        key = _key(layout, euclidean, states, node, query, index, best_key)
+        key = _key(layout, euclidean, states, node, query, offset, axes, weight, best_key)
         if key < best_key:
             best, best_key = node, key
     order, points, stack, gaps = index.order, index.points, index.stack, index.gaps
-    axes = index.ints[Setting.AXES]
     stack[0, 0], stack[0, 1] = 0, built
     gaps[0, 0] = gaps[0, 1] = gaps[0, 2] = 0.0
     depth = 1
@@ -211,7 +220,7 @@ def indexed_nearest(
             squared += gap * gap
         share = squared if euclidean else weight * np.sqrt(squared)
         if share <= best_key:
-            key = _key(layout, euclidean, states, node, query, index, best_key)
+            key = _key(layout, euclidean, states, node, query, offset, axes, weight, best_key)
             if key < best_key or (key == best_key and node < best):
                 best, best_key = node, key
         if hi - lo == 1:

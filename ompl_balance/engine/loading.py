@@ -29,8 +29,11 @@ def view_key(value: Any) -> Any:
     """What numba compiles a specialization of the engine for, as a hashable key: the classes of
     named tuples with the keys of their fields, arrays by dtype, dimensions and layout, scalars by type.
 
-    The keys of the last views asked about are remembered (a solve asks about the same views again).
+    The keys of the last views asked about are remembered (a solve asks about the same views
+    again); a plain tuple is keyed item by item, so ``(view, layout)`` finds both remembered.
     """
+    if isinstance(value, tuple) and not hasattr(value, "_fields"):
+        return tuple(view_key(item) for item in value)
     if isinstance(value, tuple):
         known = _KEYS.get(id(value))
         if known is not None and known[0] is value:
@@ -48,9 +51,9 @@ _KEYS: dict[int, tuple[Any, Any]] = {}  # id -> (the value, its key), the value 
 
 def _view_key(value: Any) -> Any:
     if isinstance(value, tuple) and hasattr(value, "_fields"):
-        return (type(value), tuple(_view_key(field) for field in value))
+        return (type(value), tuple(view_key(field) for field in value))
     if isinstance(value, tuple):
-        return tuple(_view_key(item) for item in value)
+        return tuple(view_key(item) for item in value)
     if isinstance(value, np.ndarray):
         return (value.dtype.str, value.ndim, value.flags.c_contiguous, value.flags.writeable)
     return type(value)

@@ -8,9 +8,10 @@ tree towards the state just added until it is trapped or reaches it. It calls th
 checker's kernels through the view it is given (:mod:`ompl_balance.core.checks`), so numba
 compiles it once per kind of checker.
 
-It runs at most ``budget`` iterations and returns why it stopped (:class:`Stop`), so the
-Python side (:mod:`ompl_balance.engine.driver`) polls the termination condition between
-calls, feeds goal states, makes room in the trees and ends the solve when the trees
+It runs iterations for a slice of time (its own monotonic clock, read once an iteration:
+:mod:`ompl_balance.engine.clock`) and returns why it stopped (:class:`Stop`), so the Python
+side (:mod:`ompl_balance.engine.driver`) polls the termination condition between calls,
+feeds goal states, makes room in the trees and ends the solve when the trees
 connect. Everything it changes lives in arrays the caller owns (:class:`Loop`), so a call
 resumes where the last one stopped. The rules themselves (balancing, swaps, exhaustion,
 node quality) are the functions of :mod:`ompl_balance.policies`, compiled here.
@@ -29,6 +30,7 @@ from .. import policies
 from ..core.checks import motion_free, state_free
 from ..core.compiled_spaces import distance, equal, interpolate, row_distance, sample_from_uniforms, segment_count
 from ..core.layout import SpaceLayout
+from .clock import monotonic_ns
 from .events import Grow
 from .index import KDIndex, indexed_nearest
 
@@ -44,7 +46,7 @@ START, GOAL = 0, 1  # tree indices
 class Stop(enum.IntEnum):
     """Why :func:`run` returned."""
 
-    BUDGET = 0  # ran its iterations
+    SLICE = 0  # its slice of time is over
     NEED_GOAL = 1  # the goal tree wants a goal state (fed by the caller, then GOAL_FED set)
     NEED_ROOM = 2  # a tree or the record has less room than one iteration may need
     CONNECTED = 3  # the trees connected: Slot.START_NODE, Slot.GOAL_NODE
@@ -361,12 +363,14 @@ def run(
     trees: tuple[Tree, Tree],
     loop: Loop,
     rng: Any,
-    budget: int,
+    slice_ns: int,
 ) -> int:  # pragma: no cover (compiled)
-    """Run at most ``budget`` iterations of the loop; returns why it stopped (:class:`Stop`)."""
+    """Run iterations of the loop for ``slice_ns`` nanoseconds (the iteration under way when they
+    are over finishes; ``slice_ns <= 0``: none); returns why it stopped (:class:`Stop`)."""
     ints, sizes = loop.ints, loop.sizes
     room = ints[Slot.ROOM]
-    for _ in range(budget):
+    deadline = monotonic_ns() + slice_ns
+    while monotonic_ns() < deadline:
         if ints[Slot.GOAL_FED] == 0:
             for t in range(2):
                 if trees[t].parents.shape[0] - sizes[t] < room:
@@ -446,4 +450,4 @@ def run(
             continue
         ints[Slot.START_NODE], ints[Slot.GOAL_NODE] = (added, reached) if grow_start else (reached, added)
         return Stop.CONNECTED
-    return Stop.BUDGET
+    return Stop.SLICE

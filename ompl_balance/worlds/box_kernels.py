@@ -12,7 +12,7 @@ from ..core.checks import Count
 from .boxes import BoxKernel
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def box_state_free(view: BoxKernel, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
     """:meth:`BoxWorld2D.is_free` of ``(q[0], q[1])``: finite and in no closed box; counts one state."""
     view.counts[Count.STATES] += 1

@@ -12,7 +12,7 @@ from ..core.checks import Count
 from .occupancy import GridKernel
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def grid_state_free(view: GridKernel, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
     """:meth:`OccupancyGrid.is_free` of ``(q[0], q[1])``: finite and in a free cell; counts one state."""
     view.counts[Count.STATES] += 1

@@ -1,0 +1,103 @@
+"""The compiled engine's k-d tree over positions answers every query as the linear scan does:
+the same node (the lowest index among equally near ones) and the same distance, while the tree
+grows between queries (nodes added since the last build scanned, rebuilds as it grows)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numba import njit
+from ompl import base as ob
+
+from ompl_balance.core.compiled_spaces import nearest
+from ompl_balance.core.layout import layout_for
+from ompl_balance.engine.index import INDEX_FROM, indexed_nearest, new_index
+
+
+def real_space(dim: int) -> ob.StateSpace:
+    space = ob.RealVectorStateSpace(dim)
+    space.setBounds(-1.0, 1.0)
+    return space
+
+
+def se2_space() -> ob.StateSpace:
+    space = ob.SE2StateSpace()
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(-1.0)
+    bounds.setHigh(1.0)
+    space.setBounds(bounds)
+    return space
+
+
+def se3_space() -> ob.StateSpace:
+    space = ob.SE3StateSpace()
+    bounds = ob.RealVectorBounds(3)
+    bounds.setLow(-1.0)
+    bounds.setHigh(1.0)
+    space.setBounds(bounds)
+    return space
+
+
+def weighted_compound() -> ob.StateSpace:
+    space = ob.CompoundStateSpace()
+    space.addSubspace(real_space(3), 0.5)
+    space.addSubspace(ob.SO2StateSpace(), 2.0)
+    return space
+
+
+SPACES = {"R^2": lambda: real_space(2), "R^3": lambda: real_space(3), "SE(2)": se2_space, "SE(3)": se3_space}
+SPACES["R^3 x SO(2), weighted"] = weighted_compound
+
+
+def random_states(layout, count: int, rng: np.random.Generator) -> np.ndarray:
+    """States of the layout: positions (with many repeated, for ties), angles, unit quaternions."""
+    states = np.empty((count, layout.dim))
+    for leaf in range(len(layout.kind)):
+        start, size, kind = int(layout.offset[leaf]), int(layout.size[leaf]), int(layout.kind[leaf])
+        block = states[:, start : start + size]
+        if kind == 0:
+            block[:] = rng.uniform(-1.0, 1.0, (count, size)).round(2)  # a coarse grid: equal distances occur
+        elif kind == 1:
+            block[:] = rng.uniform(-np.pi, np.pi, (count, 1))
+        else:
+            q = rng.normal(size=(count, 4))
+            block[:] = q / np.linalg.norm(q, axis=1)[:, None]
+    return states
+
+
+@njit
+def queries_as_it_grows(index, layout, states, queries, found, scanned):  # pragma: no cover (compiled)
+    """Query ``queries[n - 1]`` with the first ``n`` states, for n = 1, 2, ...: (node, distance) rows."""
+    for size in range(1, states.shape[0] + 1):
+        node, distance = indexed_nearest(index, layout, states, size, queries[size - 1])
+        found[size - 1, 0], found[size - 1, 1] = node, distance
+        node, distance = nearest(layout, states, size, queries[size - 1])
+        scanned[size - 1, 0], scanned[size - 1, 1] = node, distance
+
+
+@pytest.mark.parametrize("name", SPACES)
+def test_the_index_answers_as_the_linear_scan_while_the_tree_grows(name):
+    space = SPACES[name]()
+    space.setup()
+    layout = layout_for(space)
+    rng = np.random.default_rng(3)
+    count = 6 * INDEX_FROM + 123  # several rebuilds, with nodes left unbuilt between them
+    states = random_states(layout, count, rng)
+    queries = random_states(layout, count, rng)
+    queries[::7] = states[rng.integers(0, count, len(queries[::7]))]  # queries on nodes: distance 0
+    index = new_index(layout, count)
+    found, scanned = np.empty((count, 2)), np.empty((count, 2))
+    queries_as_it_grows(index, layout, states, queries, found, scanned)
+    np.testing.assert_array_equal(found[:, 0], scanned[:, 0])  # the same node, ties to the lowest index
+    np.testing.assert_allclose(found[:, 1], scanned[:, 1], rtol=0.0, atol=1e-12)
+    # the scan itself against OMPL's own distance, for some queries
+    si = ob.SpaceInformation(space)
+    a, b = si.allocState(), si.allocState()
+    for row in rng.integers(INDEX_FROM, count, 20):
+        space.copyFromReals(b, queries[row].tolist())
+        distances = []
+        for node in range(row + 1):
+            space.copyFromReals(a, states[node].tolist())
+            distances.append(si.distance(a, b))
+        assert int(np.argmin(distances)) == int(scanned[row, 0])
+        assert abs(min(distances) - scanned[row, 1]) < 1e-9
