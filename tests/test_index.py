@@ -20,18 +20,9 @@ def real_space(dim: int) -> ob.StateSpace:
     return space
 
 
-def se2_space() -> ob.StateSpace:
-    space = ob.SE2StateSpace()
-    bounds = ob.RealVectorBounds(2)
-    bounds.setLow(-1.0)
-    bounds.setHigh(1.0)
-    space.setBounds(bounds)
-    return space
-
-
-def se3_space() -> ob.StateSpace:
-    space = ob.SE3StateSpace()
-    bounds = ob.RealVectorBounds(3)
+def rigid_space(space: ob.StateSpace, positions: int) -> ob.StateSpace:
+    """``space`` (SE(2) or SE(3)) with its ``positions`` coordinates bounded to [-1, 1]."""
+    bounds = ob.RealVectorBounds(positions)
     bounds.setLow(-1.0)
     bounds.setHigh(1.0)
     space.setBounds(bounds)
@@ -45,7 +36,12 @@ def weighted_compound() -> ob.StateSpace:
     return space
 
 
-SPACES = {"R^2": lambda: real_space(2), "R^3": lambda: real_space(3), "SE(2)": se2_space, "SE(3)": se3_space}
+SPACES = {
+    "R^2": lambda: real_space(2),
+    "R^3": lambda: real_space(3),
+    "SE(2)": lambda: rigid_space(ob.SE2StateSpace(), 2),
+    "SE(3)": lambda: rigid_space(ob.SE3StateSpace(), 3),
+}
 SPACES["R^3 x SO(2), weighted"] = weighted_compound
 
 
