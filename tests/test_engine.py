@@ -172,6 +172,19 @@ def test_the_kernels_and_the_path_they_take_are_reported():
     assert planner.stats.exits >= planner.stats.motions_checked  # a call out per motion (and goal state)
 
 
+def test_auto_plans_python_checks_on_the_python_engine_and_kernels_compiled():
+    """engine=auto with every check a call to Python (here a Python callable): the Python engine,
+    even with the compiled one loaded; with the package's kernels: the compiled engine."""
+    for make, engine in ((shell_setup, "python"), (get_problem("bug_trap").setup, "compiled")):
+        ss = make()
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        ss.setPlanner(planner)
+        ss.setup()
+        planner.wait_for_engine()
+        assert ss.solve(10.0)
+        assert planner.stats.engine == engine
+
+
 def robot_setup(motion, scene="arm3", problem_index=0):
     """A robot problem with the package's checker: the 3-joint test arm among four obstacles (a
     start and goal on either side of the wall) or a MotionBenchMaker Panda problem."""
