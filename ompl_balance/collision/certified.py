@@ -66,7 +66,6 @@ above, so grazing edges end (rejected) after a bounded number of halvings.
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,6 +84,7 @@ from .advancement import (
     memory_row,
     sphere_bounds,
 )
+from .bisection import bisect_segments
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
 from .kernels import CertifiedMotions, certified_edge_free, robot_states
@@ -343,45 +343,18 @@ class MotionCertifier:
             for pair, (t0, t1, _, _) in zip(pairs.tolist(), spans.tolist()):
                 if self.checker.pair_touching(pair, poses(0.5 * (t0 + t1))):
                     return True, 0.0
-        order = np.argsort(spans[:, 0] - spans[:, 1], kind="stable")  # widest first: coarse to fine
-        queue = deque((int(pairs[i]), *spans[i].tolist()) for i in order)
-        while queue:
-            pair, t0, t1, d0, d1 = queue.popleft()
-            if t0 >= bad:
-                continue
-            travel = speed[pair] * (t1 - t0)
-            for t in (t0, t1) if d0 <= d1 else (t1, t0):  # the smaller bound first
-                if d0 + d1 - 2.0 * clearance > travel:
-                    break
-                # both are lower bounds; an exact -inf (contact) is a fact
-                if t == t0:
-                    d0 = _sharper(d0, distance(pair, t))
-                else:
-                    d1 = _sharper(d1, distance(pair, t))
-            if d0 + d1 - 2.0 * clearance > travel:
-                continue
-            for t, d in ((t0, d0), (t1, d1)):
-                if d <= clearance:  # (exact: the sharpening reached it)
-                    failed = True
-                    if not last_valid:
-                        return True, 0.0
-                    bad = min(bad, t)
-            if travel < MIN_TRAVEL or t0 >= bad or (failed and t1 >= bad and travel < settle):
-                failed = True
-                if not last_valid:
-                    return True, 0.0
-                bad = min(bad, t0)
-                continue
-            middle = 0.5 * (t0 + t1)
-            dm = distance(pair, middle)
-            queue.append((pair, t0, middle, d0, dm))
-            queue.append((pair, middle, t1, dm, d1))
-        return failed, bad
-
-
-def _sharper(bound: float, exact: float) -> float:
-    """The better of a lower bound and an exact distance (``-inf``: contact, which stands)."""
-    return exact if exact == -np.inf else max(bound, exact)
+        segments = [(pair, t0, t1, d0, d1) for pair, (t0, t1, d0, d1) in zip(pairs.tolist(), spans.tolist())]
+        return bisect_segments(
+            segments,
+            distance,
+            lambda pair: speed[pair],
+            lambda pair: clearance,
+            MIN_TRAVEL,
+            settle,
+            last_valid,
+            failed,
+            bad,
+        )
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ from ..core.trees import ArrayTree
 from ..policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause
 from . import loop
 from .events import Grow, GrowStep, TreeChoiceEvent
-from .index import new_index
+from .index import grown, new_index
 from .loading import view_key
 from .loop import Real, Record, Slot, Stop
 from .solve import Solve
@@ -98,13 +98,7 @@ class _Arrays:
             failures.reserve(capacity)
             if len(self.costs[t]) < capacity:
                 self.costs[t] = _grown(self.costs[t], capacity)
-            index = self.indexes[t]
-            if len(index.order) < capacity:
-                self.indexes[t] = index = index._replace(
-                    order=_grown(index.order, capacity),
-                    points=_grown(index.points, capacity),
-                    axis=_grown(index.axis, capacity),
-                )
+            self.indexes[t] = index = grown(self.indexes[t], capacity)
             trees.append(
                 loop.Tree(storage.states, storage.parents, storage.roots, failures.array, self.costs[t], index)
             )
@@ -185,9 +179,22 @@ def run(
     exits_before = int(checks.view.counts[Count.EXITS])
     status = ob.PlannerStatus.TIMEOUT
     run_slice = _runner(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, SLICE_NS)
+
+    def feed_goal() -> bool:
+        """The goal state the next iteration asks for, fed; ``False`` when there is none."""
+        if not solve.feed_goal(ptc):
+            return False
+        arrays.trees = arrays.make_room()
+        ints[Slot.GOAL_FED] = 1
+        return True
+
     with interrupts_between_slices() as raise_interrupt:
         try:
             while not ptc():
+                # (a slice's first iteration asks here rather than by a stop, a slice the fewer)
+                if ints[Slot.GOAL_FED] == 0 and solve.wants_goal() and not feed_goal():
+                    status = ob.PlannerStatus.INVALID_GOAL
+                    break
                 ints[Slot.SAMPLED_GOALS] = solve.inputs.getSampledGoalsCount()
                 ints[Slot.MORE_GOALS] = solve.inputs.haveMoreGoalStates()
                 stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, SLICE_NS)
@@ -197,11 +204,9 @@ def run(
                 if stop == Stop.NEED_ROOM:
                     arrays.trees = arrays.make_room()
                 elif stop == Stop.NEED_GOAL:
-                    if not solve.feed_goal(ptc):
+                    if not feed_goal():
                         status = ob.PlannerStatus.INVALID_GOAL
                         break
-                    arrays.trees = arrays.make_room()
-                    ints[Slot.GOAL_FED] = 1
                 elif stop == Stop.CONNECTED and solve.accept(int(ints[Slot.START_NODE]), int(ints[Slot.GOAL_NODE])):
                     status = ob.PlannerStatus.EXACT_SOLUTION
                     break

@@ -1,21 +1,36 @@
-"""An exact nearest-neighbour index for the compiled engine's trees: a k-d tree over positions.
+"""An exact nearest-neighbour index for the compiled engine's trees: a k-d tree over positions
+and rotations.
 
 A linear scan costs each query one distance per node; for trees of tens of thousands of
-nodes that dominates an iteration. Where a space's metric has a position part, a real-vector
-leaf of 2 or 3 coordinates with weight ``w`` (R^2, R^3, SE(2), SE(3) and compounds with such a
-leaf), every distance is at least ``w`` times the Euclidean distance of the positions (the
-other leaves add non-negative terms, and in floating point a sum of non-negative terms is
-never below one of them). :class:`KDIndex` keeps the nodes' positions in a k-d tree, rebuilt
-as the tree grows, plus the nodes added since the last build, which a query scans. A query
-descends towards its own position first and skips a subtree whose splitting plane is farther
-than the best distance found (``w`` times the distance to the plane bounds every node beyond
-it from below). The answer is the linear scan's, node for node: the least distance, and the
-lowest index among equal ones (subtrees are skipped only when strictly farther).
+nodes that dominates an iteration. The index applies where a space's metric has a position
+part (a real-vector leaf of 2 or 3 coordinates, weight ``w_p``) or a rotation part (an SO(2)
+or SO(3) leaf, weight ``w_r``): R^2, R^3, SO(2), SO(3), SE(2), SE(3) and compounds with such
+leaves. Each node gets up to seven *index coordinates*: its position, and its rotation as a
+point whose distances are chords of the rotation distance:
+
+* SO(2), an angle ``a``: ``(cos a, sin a)``; two angles ``d`` apart (the shorter arc) are a
+  chord ``2 sin(d / 2) <= d`` apart (as far as OMPL's distance of angles is one: angles less
+  than ``2 pi`` apart);
+* SO(3), a unit quaternion ``q``: ``|q|`` taken coordinate by coordinate, which makes ``q`` and
+  ``-q`` (one rotation) the same point; OMPL's distance ``d = acos(|q1 . q2|)`` has chord
+  ``min(||q1 - q2||, ||q1 + q2||) = 2 sin(d / 2) <= d``, and ``||(|q1| - |q2|)||`` is at most that.
+
+So every distance is at least ``w_p`` times the distance of the positions plus ``w_r`` times
+that of the rotation points (less :data:`CHORD_SLACK`, for OMPL's tolerance that calls nearly
+equal quaternions 0 apart and for rounding); the other leaves add non-negative terms.
+:class:`KDIndex` keeps the nodes' index coordinates in a k-d tree, rebuilt as the tree grows,
+plus the nodes added since the last build, which a query scans. A query descends towards its
+own coordinates first and skips a subtree whose bound, from how far the query lies outside it
+along each axis, is above the best distance found. The answer is the linear scan's, node for
+node: the least distance, and the lowest index among equal ones (subtrees are skipped only
+when strictly farther). A quaternion not of unit length (to :data:`UNIT_TOLERANCE`) leaves
+the rotation out of the bounds of that build or query.
 """
 
 from __future__ import annotations
 
 import enum
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -31,45 +46,58 @@ INDEX_FROM = 256
 UNBUILT_FRACTION = 1 / 32
 #: Depth of a query's stack: enough for a k-d tree of 2**62 nodes.
 STACK = 128
+#: Taken off the rotation's chord bound: OMPL's distance of quaternions ``|q1 . q2| > 1 - 1e-9``
+#: is 0 where their chord is up to 4.5e-5, and rounding.
+CHORD_SLACK = 1e-4
+#: How far a quaternion's squared norm may be from 1 for the rotation to count in the bounds.
+UNIT_TOLERANCE = 1e-12
 NONE = -1
 
 
 class Setting(enum.IntEnum):
     """The index's integers (:attr:`KDIndex.ints`)."""
 
-    OFFSET = 0  # the position leaf's first coordinate (-1: no position leaf: scan)
-    AXES = 1  # its coordinates, 2 or 3
-    BUILT = 2  # nodes 0 .. BUILT - 1 are in the k-d tree
-    COUNT = 3
+    POSITION = 0  # the position leaf's first coordinate (-1: none)
+    POSITION_AXES = 1  # its coordinates: 0, 2 or 3
+    ROTATION = 2  # the rotation leaf's first coordinate (-1: none)
+    ROTATION_KIND = 3  # its Leaf kind (SO2 or SO3)
+    AXES = 4  # index coordinates in all (0: no position or rotation leaf: the tree is scanned)
+    BUILT = 5  # nodes 0 .. BUILT - 1 are in the k-d tree
+    UNIT_ROTATIONS = 6  # 1 when the built nodes' rotations count in the bounds
+    COUNT = 7
 
 
 class KDIndex(NamedTuple):
-    """One tree's k-d tree over node positions.
+    """One tree's k-d tree over the nodes' index coordinates.
 
     ``order`` (capacity,): node indices in k-d layout (the subtree of ``order[lo:hi]`` has its
     splitting node at ``order[(lo + hi) // 2]``, smaller coordinates before it, larger after);
-    ``points`` (capacity, 3): their positions in the same order (a query walks them, not the
-    tree's scattered states); ``axis`` (capacity,): the splitting axis at the middle of each
-    subtree of two nodes or more;
-    ``stack`` (STACK, 2) and ``gaps`` (STACK, 3): a query's pending subtrees and, per axis, how far
-    the query lies outside each (their distance from it is at least the norm of that);
-    ``weight`` (1,): the position leaf's weight.
+    ``points`` (capacity, axes): their index coordinates in the same order (a query walks them,
+    not the tree's scattered states; ``axes``: up to 3 of a position and 4 of a rotation,
+    ``ints[Setting.AXES]``); ``coordinates`` (capacity, axes): each node's, by node
+    (the build's scratch); ``axis`` (capacity,): the splitting axis at the middle of each
+    subtree of two nodes or more; ``stack`` (STACK, 2) and ``gaps`` (STACK, axes): a query's
+    pending subtrees and, per axis, how far the query lies outside each; ``query`` (axes,):
+    the query's index coordinates; ``weight`` (2,): the position's and the rotation's weights.
     """
 
     order: np.ndarray
     points: np.ndarray
+    coordinates: np.ndarray
     axis: np.ndarray
     stack: np.ndarray
     gaps: np.ndarray
+    query: np.ndarray
     ints: np.ndarray
     weight: np.ndarray
 
 
-def position_leaf(layout: SpaceLayout) -> int:
-    """The leaf the index keeps: the first real-vector leaf of 2 or 3 coordinates with a
-    positive weight; -1 when there is none (the tree is scanned)."""
+def _first_leaf(layout: SpaceLayout, kinds: tuple[Leaf, ...], sizes: tuple[int, ...]) -> int:
+    """The first leaf of one of ``kinds`` (a real-vector one of one of ``sizes``) with a
+    positive weight; -1 when there is none."""
     for leaf in range(len(layout.kind)):
-        if layout.kind[leaf] == Leaf.REAL and layout.size[leaf] in (2, 3) and layout.weight[leaf] > 0.0:
+        kind = Leaf(int(layout.kind[leaf]))
+        if kind in kinds and layout.weight[leaf] > 0.0 and (kind != Leaf.REAL or layout.size[leaf] in sizes):
             return leaf
     return NONE
 
@@ -77,78 +105,85 @@ def position_leaf(layout: SpaceLayout) -> int:
 def new_index(layout: SpaceLayout, capacity: int) -> KDIndex:
     """An empty index for a tree of ``capacity`` nodes in ``layout``."""
     ints = np.zeros(Setting.COUNT, dtype=np.int64)
-    leaf = position_leaf(layout)
-    ints[Setting.OFFSET] = NONE if leaf == NONE else layout.offset[leaf]
-    ints[Setting.AXES] = 0 if leaf == NONE else layout.size[leaf]
-    weight = np.array([0.0 if leaf == NONE else layout.weight[leaf]])
-    return KDIndex(
-        np.zeros(capacity, dtype=np.int64),
-        np.zeros((capacity, 3)),
-        np.zeros(capacity, dtype=np.int64),
-        np.zeros((STACK, 2), dtype=np.int64),
-        np.zeros((STACK, 3)),
-        ints,
-        weight,
+    weight = np.zeros(2)
+    position = _first_leaf(layout, (Leaf.REAL,), (2, 3))
+    rotation = _first_leaf(layout, (Leaf.SO2, Leaf.SO3), ())
+    ints[Setting.POSITION] = ints[Setting.ROTATION] = NONE
+    if position != NONE:
+        ints[Setting.POSITION], ints[Setting.POSITION_AXES] = layout.offset[position], layout.size[position]
+        weight[0] = layout.weight[position]
+    if rotation != NONE:
+        ints[Setting.ROTATION], ints[Setting.ROTATION_KIND] = layout.offset[rotation], layout.kind[rotation]
+        weight[1] = layout.weight[rotation]
+    rotation_axes = 0 if rotation == NONE else (2 if layout.kind[rotation] == Leaf.SO2 else 4)
+    axes = ints[Setting.AXES] = ints[Setting.POSITION_AXES] + rotation_axes
+    return grown(
+        KDIndex(
+            np.zeros(0, dtype=np.int64),
+            np.zeros((0, axes)),
+            np.zeros((0, axes)),
+            np.zeros(0, dtype=np.int64),
+            np.zeros((STACK, 2), dtype=np.int64),
+            np.zeros((STACK, axes)),
+            np.zeros(axes),
+            ints,
+            weight,
+        ),
+        capacity,
     )
 
 
-@njit(cache=True)
-def _select(order: np.ndarray, states: np.ndarray, column: int, lo: int, hi: int, k: int) -> None:  # pragma: no cover
-    """Reorder ``order[lo:hi]`` so that ``order[k]`` has the k-th smallest ``states[., column]``,
-    none after it smaller and none before it larger (Hoare's selection)."""
-    while hi - lo > 1:
-        pivot = states[order[(lo + hi) // 2], column]
-        i, j = lo, hi - 1
-        while i <= j:
-            while states[order[i], column] < pivot:
-                i += 1
-            while states[order[j], column] > pivot:
-                j -= 1
-            if i <= j:
-                order[i], order[j] = order[j], order[i]
-                i += 1
-                j -= 1
-        if k <= j:
-            hi = j + 1
-        elif k >= i:
-            lo = i
-        else:
-            return
+def grown(index: KDIndex, capacity: int) -> KDIndex:
+    """``index`` with room for ``capacity`` nodes (itself when it has that room)."""
+    if len(index.order) >= capacity:
+        return index
+
+    def more(array: np.ndarray) -> np.ndarray:
+        bigger = np.zeros((capacity, *array.shape[1:]), dtype=array.dtype)
+        bigger[: len(array)] = array
+        return bigger
+
+    return index._replace(
+        order=more(index.order), points=more(index.points), coordinates=more(index.coordinates), axis=more(index.axis)
+    )
 
 
-@njit(cache=True)
-def _build(index: KDIndex, states: np.ndarray, size: int) -> None:  # pragma: no cover (compiled)
-    """The k-d tree of nodes ``0 .. size - 1``: each subtree split at its median along its
-    widest axis."""
-    order, offset, axes = index.order, index.ints[Setting.OFFSET], index.ints[Setting.AXES]
-    for node in range(size):
-        order[node] = node
-    stack = index.stack
-    stack[0, 0], stack[0, 1] = 0, size
-    depth = 1
-    while depth > 0:
-        depth -= 1
-        lo, hi = stack[depth, 0], stack[depth, 1]
-        if hi - lo < 2:
-            continue
-        widest, spread = 0, -1.0
-        for axis in range(axes):
-            smallest, largest = np.inf, -np.inf
-            for i in range(lo, hi):
-                value = states[order[i], offset + axis]
-                smallest, largest = min(smallest, value), max(largest, value)
-            if largest - smallest > spread:
-                widest, spread = axis, largest - smallest
-        middle = (lo + hi) // 2
-        _select(order, states, offset + widest, lo, hi, middle)
-        index.axis[middle] = widest
-        stack[depth, 0], stack[depth, 1] = lo, middle
-        stack[depth + 1, 0], stack[depth + 1, 1] = middle + 1, hi
-        depth += 2
-    for i in range(size):
-        for axis in range(axes):
-            index.points[i, axis] = states[order[i], offset + axis]
-    index.ints[Setting.BUILT] = size
+@njit(cache=True, inline="always")
+def _index_coordinates(index: KDIndex, state: np.ndarray, out: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    """Write ``state``'s index coordinates (flat state (dim,)) into ``out`` (axes,); whether its
+    rotation may count in the bounds (an angle; a quaternion of unit length)."""
+    ints = index.ints
+    position, axes = ints[Setting.POSITION], ints[Setting.POSITION_AXES]
+    for k in range(axes):
+        out[k] = state[position + k]
+    rotation = ints[Setting.ROTATION]
+    if rotation == NONE:
+        return True
+    if ints[Setting.ROTATION_KIND] == Leaf.SO2:
+        angle = state[rotation]
+        out[axes], out[axes + 1] = math.cos(angle), math.sin(angle)
+        return True
+    squared = 0.0
+    for k in range(4):
+        value = state[rotation + k]
+        out[axes + k] = abs(value)
+        squared += value * value
+    return abs(squared - 1.0) <= UNIT_TOLERANCE
+
+
+@njit(cache=True, inline="always")
+def _bound(
+    euclidean: bool, position_squared: float, rotation_squared: float, weight: np.ndarray, rotations: bool
+) -> float:  # pragma: no cover (compiled)
+    """The least key of a node whose index coordinates are at least these squared distances
+    (position, rotation) from the query's: a squared distance (Euclidean spaces, as the scan
+    compares) or a distance."""
+    if euclidean:
+        return position_squared
+    bound = weight[0] * math.sqrt(position_squared)
+    if rotations:
+        bound += weight[1] * max(math.sqrt(rotation_squared) - CHORD_SLACK, 0.0)
+    return bound
 
 
 @njit(cache=True, inline="always")
@@ -181,61 +216,166 @@ def _key(
     return share if share > best else row_distance(layout, states, node, query)
 
 
+@njit(cache=True, inline="always")
+def _scan(
+    layout: SpaceLayout,
+    euclidean: bool,
+    states: np.ndarray,
+    lo: int,
+    hi: int,
+    query: np.ndarray,
+    offset: int,
+    axes: int,
+    weight: float,
+) -> tuple[int, float]:  # pragma: no cover (compiled)
+    """The node of ``lo .. hi - 1`` nearest ``query`` (the first on ties) and its key
+    (:func:`_key`); ``(-1, inf)`` for none."""
+    best, best_key = NONE, np.inf
+    for node in range(lo, hi):
+        key = _key(layout, euclidean, states, node, query, offset, axes, weight, best_key)
+        if key < best_key:
+            best, best_key = node, key
+    return best, best_key
+
+
+@njit(cache=True)
+def _select(order: np.ndarray, values: np.ndarray, column: int, lo: int, hi: int, k: int) -> None:  # pragma: no cover
+    """Reorder ``order[lo:hi]`` so that ``order[k]`` has the k-th smallest ``values[., column]``,
+    none after it smaller and none before it larger (Hoare's selection)."""
+    while hi - lo > 1:
+        pivot = values[order[(lo + hi) // 2], column]
+        i, j = lo, hi - 1
+        while i <= j:
+            while values[order[i], column] < pivot:
+                i += 1
+            while values[order[j], column] > pivot:
+                j -= 1
+            if i <= j:
+                order[i], order[j] = order[j], order[i]
+                i += 1
+                j -= 1
+        if k <= j:
+            hi = j + 1
+        elif k >= i:
+            lo = i
+        else:
+            return
+
+
+@njit(cache=True)
+def _build(index: KDIndex, states: np.ndarray, size: int) -> None:  # pragma: no cover (compiled)
+    """The k-d tree of nodes ``0 .. size - 1``: each subtree split at its median along its
+    widest axis (spreads weighted as their part of the distance). A node's state does not
+    change once added, so its index coordinates are worked out at the first build only."""
+    order, coordinates, ints = index.order, index.coordinates, index.ints
+    axes, position_axes = ints[Setting.AXES], ints[Setting.POSITION_AXES]
+    unit = ints[Setting.BUILT] == 0 or ints[Setting.UNIT_ROTATIONS] == 1
+    for node in range(ints[Setting.BUILT], size):
+        if not _index_coordinates(index, states[node], coordinates[node]):
+            unit = False
+    ints[Setting.UNIT_ROTATIONS] = 1 if unit else 0
+    for node in range(size):
+        order[node] = node
+    stack = index.stack
+    stack[0, 0], stack[0, 1] = 0, size
+    depth = 1
+    while depth > 0:
+        depth -= 1
+        lo, hi = stack[depth, 0], stack[depth, 1]
+        if hi - lo < 2:
+            continue
+        widest, spread = 0, -1.0
+        for axis in range(axes):
+            smallest, largest = np.inf, -np.inf
+            for i in range(lo, hi):
+                value = coordinates[order[i], axis]
+                smallest, largest = min(smallest, value), max(largest, value)
+            weighted = (largest - smallest) * index.weight[0 if axis < position_axes else 1]
+            if weighted > spread:
+                widest, spread = axis, weighted
+        middle = (lo + hi) // 2
+        _select(order, coordinates, widest, lo, hi, middle)
+        index.axis[middle] = widest
+        stack[depth, 0], stack[depth, 1] = lo, middle
+        stack[depth + 1, 0], stack[depth + 1, 1] = middle + 1, hi
+        depth += 2
+    for i in range(size):
+        for axis in range(axes):
+            index.points[i, axis] = coordinates[order[i], axis]
+    ints[Setting.BUILT] = size
+
+
 @njit(cache=True)
 def indexed_nearest(
     index: KDIndex, layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
     """The node of ``states[:size]`` nearest ``query`` and its distance, as the linear scan
     (:func:`~ompl_balance.core.compiled_spaces.nearest`) answers; through the k-d tree when it applies."""
-    offset = index.ints[Setting.OFFSET]
-    if offset == NONE or size < INDEX_FROM:
+    ints = index.ints
+    if ints[Setting.AXES] == 0 or size < INDEX_FROM:
         return nearest(layout, states, size, query)
-    built = index.ints[Setting.BUILT]
-    if size - built > max(INDEX_FROM, int(built * UNBUILT_FRACTION)):
+    if size - ints[Setting.BUILT] > max(INDEX_FROM, int(ints[Setting.BUILT] * UNBUILT_FRACTION)):
         _build(index, states, size)
-        built = size
-    euclidean = is_euclidean(layout)  # then keys are squared distances, and so are the bounds
-    weight, axes = index.weight[0], index.ints[Setting.AXES]
-    best, best_key = NONE, np.inf
-    for node in range(built, size):  # added since the build
-        key = _key(layout, euclidean, states, node, query, offset, axes, weight, best_key)
-        if key < best_key:
-            best, best_key = node, key
+    # (``euclidean`` a constant in each search: numba's code testing it node by node costs
+    # several times more)
+    if is_euclidean(layout):
+        best, squared = _search(index, layout, states, size, query, True)
+        return best, math.sqrt(squared)
+    return _search(index, layout, states, size, query, False)
+
+
+@njit(cache=True, inline="always")
+def _search(
+    index: KDIndex, layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray, euclidean: bool
+) -> tuple[int, float]:  # pragma: no cover (compiled)
+    """The nearest node of ``states[:size]`` and its key (:func:`_key`): the nodes added since
+    the build scanned, then the k-d tree's descended."""
+    ints = index.ints
+    axes, built = ints[Setting.AXES], ints[Setting.BUILT]
+    weight, position, position_axes = index.weight, ints[Setting.POSITION], ints[Setting.POSITION_AXES]
+    best, best_key = _scan(layout, euclidean, states, built, size, query, position, position_axes, weight[0])
+    at = index.query
+    rotations = _index_coordinates(index, query, at) and ints[Setting.UNIT_ROTATIONS] == 1
     order, points, stack, gaps = index.order, index.points, index.stack, index.gaps
     stack[0, 0], stack[0, 1] = 0, built
-    gaps[0, 0] = gaps[0, 1] = gaps[0, 2] = 0.0
+    for k in range(axes):
+        gaps[0, k] = 0.0
     depth = 1
     while depth > 0:
         depth -= 1
         lo, hi = stack[depth, 0], stack[depth, 1]
-        outside = gaps[depth, 0] * gaps[depth, 0] + gaps[depth, 1] * gaps[depth, 1] + gaps[depth, 2] * gaps[depth, 2]
-        bound = outside if euclidean else weight * np.sqrt(outside)
-        if lo >= hi or bound > best_key:
+        if lo >= hi:
+            continue
+        position_squared = rotation_squared = 0.0
+        for k in range(position_axes):
+            position_squared += gaps[depth, k] * gaps[depth, k]
+        for k in range(position_axes, axes):
+            rotation_squared += gaps[depth, k] * gaps[depth, k]
+        if _bound(euclidean, position_squared, rotation_squared, weight, rotations) > best_key:
             continue  # every node of the subtree is farther than the best (ties are looked at)
         middle = (lo + hi) // 2
         node = order[middle]
-        squared = 0.0
-        for k in range(axes):
-            gap = points[middle, k] - query[offset + k]
-            squared += gap * gap
-        share = squared if euclidean else weight * np.sqrt(squared)
-        if share <= best_key:
-            key = _key(layout, euclidean, states, node, query, offset, axes, weight, best_key)
+        position_squared = rotation_squared = 0.0
+        for k in range(position_axes):
+            position_squared += (points[middle, k] - at[k]) ** 2
+        for k in range(position_axes, axes):
+            rotation_squared += (points[middle, k] - at[k]) ** 2
+        if _bound(euclidean, position_squared, rotation_squared, weight, rotations) <= best_key:
+            key = _key(layout, euclidean, states, node, query, position, position_axes, weight[0], best_key)
             if key < best_key or (key == best_key and node < best):
                 best, best_key = node, key
         if hi - lo == 1:
             continue  # a leaf: no subtrees
         axis = index.axis[middle]
-        gap = query[offset + axis] - points[middle, axis]
+        gap = at[axis] - points[middle, axis]
         near_lo, near_hi, far_lo, far_hi = (lo, middle, middle + 1, hi) if gap < 0.0 else (middle + 1, hi, lo, middle)
-        g0, g1, g2 = gaps[depth, 0], gaps[depth, 1], gaps[depth, 2]
         if far_lo < far_hi:  # the far side first: the near side is popped first
             stack[depth, 0], stack[depth, 1] = far_lo, far_hi
-            gaps[depth, 0], gaps[depth, 1], gaps[depth, 2] = g0, g1, g2
+            for k in range(axes):  # the near side's gaps are the subtree's: pushed next
+                gaps[depth + 1, k] = gaps[depth, k]
             gaps[depth, axis] = max(gaps[depth, axis], abs(gap))
             depth += 1
         if near_lo < near_hi:
             stack[depth, 0], stack[depth, 1] = near_lo, near_hi
-            gaps[depth, 0], gaps[depth, 1], gaps[depth, 2] = g0, g1, g2
             depth += 1
-    return best, np.sqrt(best_key) if euclidean else best_key
+    return best, best_key

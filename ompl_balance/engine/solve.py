@@ -52,8 +52,11 @@ class Solve:
         return self.sample_context.counts
 
     def wants_goal(self) -> bool:
-        """OMPL's rule: goal states join the goal tree while fewer than half of its states were sampled."""
-        return len(self.goal_tree) == 0 or self.inputs.getSampledGoalsCount() < len(self.goal_tree) // 2
+        """OMPL's rule: goal states join the goal tree while fewer than half of its states were
+        sampled (asked only while the goal has more: asking then adds nothing)."""
+        size = len(self.goal_tree)
+        inputs = self.inputs
+        return size == 0 or (inputs.getSampledGoalsCount() < size // 2 and inputs.haveMoreGoalStates())
 
     def feed_goal(self, ptc: ob.PlannerTerminationCondition) -> bool:
         """Add the next goal state to the goal tree (waiting for one within ``ptc`` while it is

@@ -28,7 +28,6 @@ bisected with FCL distances only (slow; the reference).
 from __future__ import annotations
 
 import math
-from collections import deque
 from typing import Any
 
 import fcl
@@ -37,6 +36,7 @@ from numpy.typing import ArrayLike
 
 from ...core.compiled_calls import entry_point
 from ..advancement import DISTANCE_TOLERANCE
+from ..bisection import bisect_segments
 from ..certified import PathCertificate
 from ..checker import WorkCounter
 from ..environment import Environment
@@ -430,40 +430,22 @@ class RigidBodyChecker:
             for pair, t0, t1, _, _ in segments:
                 if distance(int(pair), 0.5 * (t0 + t1)) == -np.inf:
                     return False, 0.0
-        queue = deque(sorted(segments, key=lambda s: s[1] - s[2]))  # widest first
-        while queue:
-            pair, t0, t1, d0, d1 = queue.popleft()
-            pair = int(pair)
-            if t0 >= bad:
-                continue
-            g = pair if pair == WHOLE else pair % len(self._parts)
-            travel = speed[g] * (t1 - t0)
-            need = travel + 2.0 * (clearance + margin[g])
-            for t in (t0, t1) if d0 <= d1 else (t1, t0):
-                if d0 + d1 > need:
-                    break
-                if t == t0:
-                    d0 = _sharper(d0, distance(pair, t))
-                else:
-                    d1 = _sharper(d1, distance(pair, t))
-            if d0 + d1 > need:
-                continue
-            for t, d in ((t0, d0), (t1, d1)):
-                if d <= clearance + margin[g]:
-                    failed = True
-                    if not last_valid:
-                        return False, 0.0
-                    bad = min(bad, t)
-            if travel < MIN_TRAVEL * scale or t0 >= bad or (failed and t1 >= bad and travel < settle):
-                failed = True
-                if not last_valid:
-                    return False, 0.0
-                bad = min(bad, t0)
-                continue
-            middle = 0.5 * (t0 + t1)
-            dm = distance(pair, middle)
-            queue.append((pair, t0, middle, d0, dm))
-            queue.append((pair, middle, t1, dm, d1))
+        parts = len(self._parts)
+
+        def group(pair: int) -> int:  # the body part of a pair (WHOLE: the whole body)
+            return pair if pair == WHOLE else pair % parts
+
+        failed, bad = bisect_segments(
+            ((int(pair), t0, t1, d0, d1) for pair, t0, t1, d0, d1 in segments),
+            distance,
+            lambda pair: speed[group(pair)],
+            lambda pair: clearance + margin[group(pair)],
+            MIN_TRAVEL * scale,
+            settle,
+            last_valid,
+            failed,
+            bad,
+        )
         if failed:
             return False, bad if last_valid else 0.0
         return True, 1.0
@@ -490,11 +472,6 @@ def _spans(segments: list[tuple[Any, ...]]) -> list[tuple[float, float]]:
         else:
             spans.append((t0, t1))
     return spans
-
-
-def _sharper(bound: float, exact: float) -> float:
-    """The better of a lower bound and an exact distance (``-inf``: contact, which stands)."""
-    return exact if exact == -np.inf else max(bound, exact)
 
 
 def certify_rigid_states(checker: RigidBodyChecker, states: np.ndarray, clearance: float = 0.0) -> PathCertificate:
