@@ -21,6 +21,7 @@ from ompl_balance.collision.geometry import Shape
 from ompl_balance.collision.rigid.advance import edge_status
 from ompl_balance.collision.rigid.body import RigidBody
 from ompl_balance.collision.rigid.checker import RigidBodyChecker
+from ompl_balance.collision.rigid.kernels import RigidCertifiedMotions, rigid_certified_motion_free
 from ompl_balance.collision.rigid.motion import interpolate, motion_split, state_pose
 from ompl_balance.collision.rigid.view import COLLIDING, FREE, UNDECIDED, state_status
 from ompl_balance.validity import rigid_body_space, rigid_state_values, set_rigid_state
@@ -294,6 +295,46 @@ def test_certified_edges_are_free_non_convex_meshes(with_box):
     for a, b in edges[:10]:
         if reference.certify(a, b)[0]:
             assert dense.first_collision(a, b) is None
+
+
+@njit
+def _certified_in_compiled_code(view, a, b):  # pragma: no cover (compiled)
+    return rigid_certified_motion_free(view, a, b)
+
+
+def test_probing_a_motion_changes_no_answer_and_refuses_colliding_motions_without_fcl_distances():
+    """Body and world all meshes: certified motions are probed at a few states first. The
+    answers are those of the same checker without the probe (from Python and from compiled
+    code), certified motions are free under the dense check, and the probe spares FCL's
+    distances on the colliding motions it catches."""
+    rng = np.random.default_rng(12)
+    environment, _ = mesh_world(rng, count=16)
+    body = RigidBody.from_triangles("SE3", l_mesh(), pieces=2)
+    low, high = np.full(3, -1.2), np.full(3, 1.2)
+    probed = RigidBodyChecker(body, environment, (low, high))
+    unprobed = RigidBodyChecker(body, environment, (low, high))
+    unprobed.view = unprobed.view._replace(probe=False)  # (the same checker, the probe switched off)
+    assert probed.view.probe
+    dense = DenseCheck(body, environment, STEP)
+    edges = [
+        (a, b) for a, b in short_edges("SE3", 60, rng, low, high, 0.9) if probed.is_valid(a) and probed.is_valid(b)
+    ]
+    compiled = RigidBodyChecker(body, environment, (low, high))  # (held: its exit is held weakly)
+    view = compiled.kernel_view()
+    assert view is not None
+    motions = RigidCertifiedMotions(view, view.counts)
+    answers = []
+    for a, b in edges:
+        answer = probed.certify(a, b)
+        assert answer == unprobed.certify(a, b)
+        assert _certified_in_compiled_code(motions, a, b) == answer[0]
+        if answer[0]:
+            assert dense.first_collision(a, b) is None
+        answers.append(answer[0])
+    assert 5 <= sum(answers) <= len(answers) - 10  # both kinds of motion were met
+    assert probed.counters()["distance_queries"] < 0.5 * unprobed.counters()["distance_queries"]
+    for work in ("motions_checked", "distance_queries"):  # compiled code probes and counts alike
+        assert compiled.counters()[work] == probed.counters()[work]
 
 
 def test_clearance_keeps_motions_away():

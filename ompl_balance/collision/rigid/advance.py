@@ -5,7 +5,11 @@
 the view's ``clearance`` apart, or refuses the motion. Pair by pair: with distance lower bounds
 ``d0``, ``d1`` at ``t0``, ``t1`` and the part's travel rate ``V = |x_b - x_a| + reach * phi``
 (no point moves faster), the pair stays at least ``(d0 + d1 - V (t1 - t0)) / 2`` apart on the
-segment, so the segment is certified when ``d0 + d1 - 2 clearance > V (t1 - t0)``. Otherwise the
+segment, so the segment is certified when ``d0 + d1 - 2 clearance > V (t1 - t0)``. First, an
+obstacle that the whole body clears over the whole motion (every point of the body stays within
+its radius of the straight line its frame origin follows; :func:`~ompl_balance.collision.rigid.view.swept_bound`)
+is certified with one bound for all parts: in a world cut into many pieces most of them are
+far from any one motion. Otherwise the
 end bounds are sharpened (part sphere first, then GJK on the convex hulls, warm-started), and if
 that does not do it the segment is halved and its midpoint bounded. Segments are processed
 coarse to fine across all pairs (first in, first out), so a collision anywhere is met early.
@@ -43,6 +47,7 @@ from .view import (
     RigidView,
     hull_bound,
     sphere_bound,
+    swept_bound,
 )
 
 #: Travel (times the view's scale) below which an uncertified segment refuses the motion.
@@ -72,7 +77,6 @@ def edge_status(
         return COLLIDING, 0.0
     translation, angle, jump = motion_split(a, b)
     parts = len(view.part_radius)
-    pairs = len(view.box_half) * parts
     clearance, solid = view.clearance, view.solid
     contact = clearance + DISTANCE_TOLERANCE * view.scale
     floor = MIN_TRAVEL * view.scale
@@ -95,22 +99,34 @@ def edge_status(
         point_t[len(known)] = t
         known[t] = len(known)
 
+    # the obstacles the whole body clears over the whole motion, one bound each, need no pairs
+    near = np.empty(len(view.box_half), dtype=np.int64)
+    candidates = 0
+    for o in range(len(near)):
+        if not swept_bound(view, point_pose[0], point_pose[1], o) > clearance:
+            near[candidates] = o
+            candidates += 1
+
     # segments: pair, (t0, t1), lower bounds at both ends, whether they are final, their points
-    seg_pair = np.empty(max(16, 2 * pairs), dtype=np.int64)
+    seg_pair = np.empty(max(16, 2 * candidates * parts), dtype=np.int64)
     seg_t = np.empty((len(seg_pair), 2))
     seg_d = np.empty((len(seg_pair), 2))
     seg_final = np.zeros((len(seg_pair), 2), dtype=np.bool_)
     seg_point = np.empty((len(seg_pair), 2), dtype=np.int64)
-    for pair in range(pairs):
-        seg_pair[pair] = pair
-        seg_t[pair, 0], seg_t[pair, 1] = 0.0, 1.0
-        seg_d[pair, 0], seg_d[pair, 1] = (
-            sphere_bound(view, point_pose[0], pair),
-            sphere_bound(view, point_pose[1], pair),
-        )
-        seg_final[pair, 0], seg_final[pair, 1] = False, False
-        seg_point[pair, 0], seg_point[pair, 1] = 0, 1
-    head, tail = 0, pairs
+    tail = 0
+    for k in range(candidates):
+        for g in range(parts):
+            pair = near[k] * parts + g
+            seg_pair[tail] = pair
+            seg_t[tail, 0], seg_t[tail, 1] = 0.0, 1.0
+            seg_d[tail, 0], seg_d[tail, 1] = (
+                sphere_bound(view, point_pose[0], pair),
+                sphere_bound(view, point_pose[1], pair),
+            )
+            seg_final[tail, 0], seg_final[tail, 1] = False, False
+            seg_point[tail, 0], seg_point[tail, 1] = 0, 1
+            tail += 1
+    head = 0
     failed, bad, hard, overflow, bounded = False, 1.0, 0, False, 0
     while head < tail:
         e = head

@@ -43,7 +43,7 @@ from ..environment import Environment
 from ..geometry import Shape, fcl_transform
 from .advance import LAST_VALID_TRAVEL, MIN_TRAVEL, edge_status
 from .body import RigidBody
-from .kernels import RigidStates, rigid_states
+from .kernels import RigidStates, probe_free, rigid_states
 from .motion import interpolate, motion_split, state_pose, valid_state
 from .pieces import soup_mesh
 from .view import (
@@ -131,6 +131,8 @@ class RigidBodyChecker:
             state[6] = 1.0
         self._state_kernel = entry_point(state_status, (self.view, state))
         self._edge_kernel = entry_point(edge_status, (self.view, state, state, False))
+        self._states_view = rigid_states(self)
+        self._probe_kernel = entry_point(probe_free, (self._states_view, state, state))
         pairs = len(self._obstacles) * len(self._parts)
         states = np.zeros((1, body.state_size))
         self._batch_kernel = entry_point(
@@ -216,12 +218,16 @@ class RigidBodyChecker:
         distances). An end that is not a valid state: not certified, fraction 0. Without
         ``last_valid`` a refused motion reports fraction 0; with it the motion is refined around
         its first failure and ``interpolate(a, b, s)`` is certified for every ``s`` up to the
-        fraction returned.
+        fraction returned. Where ``view.probe`` says so (body and world all meshes), a motion
+        without ``last_valid`` is first probed at a few states
+        (:func:`~ompl_balance.collision.rigid.kernels.probe_free`), which count as checked.
         """
         a, b = self._row(a), self._row(b)
         self.counter.motions_checked += 1
         if not self.prefilter:
             return self._finish_edge(a, b, self._whole_edge(), 1.0, False, last_valid)
+        if self.view.probe and not last_valid and not self._probe_kernel(self._states_view, a, b):
+            return False, 0.0
         status, fraction = self._edge_kernel(self.view, a, b, last_valid)
         self._count_kernel_work()
         if status == FREE:
@@ -273,7 +279,7 @@ class RigidBodyChecker:
     def kernel_view(self) -> RigidStates | None:
         """The checker as compiled code sees it (:class:`~ompl_balance.collision.rigid.kernels.RigidStates`),
         or ``None`` without ``prefilter`` (the reference path is Python's)."""
-        return rigid_states(self) if self.prefilter else None
+        return self._states_view if self.prefilter else None
 
     def counters(self) -> dict[str, int]:
         return self.counter.counters()

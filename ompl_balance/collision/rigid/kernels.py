@@ -19,6 +19,7 @@ from numba import njit, objmode
 from ...core.check_overloads import register_kernels
 from ...core.checks import Count, exit_handle, exit_target, kernels_in
 from .advance import edge_status
+from .motion import interpolate, motion_split
 from .view import BOUNDS_COMPUTED, FREE, POSES_EVALUATED, UNDECIDED, RigidView, state_status
 
 
@@ -87,15 +88,53 @@ def rigid_state_free(view: RigidStates, state: np.ndarray) -> bool:  # pragma: n
     return decide_state(view.handle, state)
 
 
+#: At most this many states probe a motion (:func:`probe_free`).
+MAX_PROBES = 31
+
+
+@njit(cache=True)
+def probe_free(view: RigidStates, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    """Whether the states at ``t = j / n`` along ``a -> b`` (OMPL's interpolation) are free,
+    visited coarse to fine (1/2, then 1/4 and 3/4, ...) up to the first that is not; ``n`` is
+    the least power of two that puts them at most the body's radius of travel apart (at most
+    :data:`MAX_PROBES` states). Counts the states it checks.
+
+    Certified motions run it first where the screening decides no state (``view.rigid.probe``:
+    body and world all meshes). There a certified motion costs tens of FCL distances, a state
+    one FCL collision test, and most of the motions a planner tries collide: a colliding state
+    refuses such a motion at once. (A body overlapping an obstacle at some point of a motion
+    overlaps it for about its own size of travel, so most collisions are met.) The ends are
+    not probed: a planner checks a motion's ends as states.
+    """
+    rigid = view.rigid
+    translation, angle, _jump = motion_split(a, b)
+    travel = translation + angle * rigid.body_radius
+    segments = 1
+    while 2 * segments - 1 <= MAX_PROBES and travel > segments * rigid.body_radius:
+        segments *= 2
+    state = np.empty(len(a))
+    denominator = 2
+    while denominator <= segments:
+        for j in range(1, denominator, 2):
+            interpolate(a, b, j / denominator, state)
+            if not rigid_state_free(view, state):
+                return False
+        denominator *= 2
+    return True
+
+
 @njit(cache=True)
 def rigid_certified_motion_free(
     view: RigidCertifiedMotions, a: np.ndarray, b: np.ndarray
 ) -> bool:  # pragma: no cover (compiled)
-    """:meth:`RigidBodyChecker.certify` of ``a -> b`` without ``last_valid``; counts one motion,
-    the poses the edge was bounded at (as states) and the distance bounds."""
+    """:meth:`RigidBodyChecker.certify` of ``a -> b`` without ``last_valid`` (probed first where
+    ``probe`` says so); counts one motion, the probed states, the poses the edge was bounded at
+    (as states) and the distance bounds."""
     states = view.states
     counts, rigid = view.counts, states.rigid
     counts[Count.MOTIONS] += 1
+    if rigid.probe and not probe_free(states, a, b):
+        return False
     status, _fraction = edge_status(rigid, a, b, False)
     counts[Count.STATES] += rigid.counts[POSES_EVALUATED]
     counts[Count.DISTANCE_QUERIES] += rigid.counts[BOUNDS_COMPUTED]

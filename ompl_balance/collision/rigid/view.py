@@ -68,7 +68,9 @@ class RigidView(NamedTuple):
     ``solid_box[o]``: obstacle ``o`` is an FCL box, so that such a corner strictly inside it is a
     contact FCL reports. ``fine``: screen states with the small
     spheres (off when body and world are all meshes: FCL then tests them whole, one call, and its
-    own hierarchy does better than small spheres). ``clearance``: what certified motions
+    own hierarchy does better than small spheres). ``probe``: certified motions first test a
+    few states along the way (on when body and world are all meshes, see
+    :func:`~ompl_balance.collision.rigid.kernels.probe_free`). ``clearance``: what certified motions
     keep; ``handover``: travel below which a non-solid pair's segment goes to FCL; ``scale``:
     the length scale of the tolerances (``max(1, reach)``).
 
@@ -100,6 +102,7 @@ class RigidView(NamedTuple):
     corners_on_surface: np.ndarray
     solid_box: np.ndarray
     fine: bool
+    probe: bool
     clearance: float
     handover: float
     scale: float
@@ -149,6 +152,7 @@ def build_view(
     solid = np.array([o.shape.convex and c for o in obstacles for c in convex], dtype=bool)
     pairs = len(obstacles) * len(body.parts)
     reach = body.reach
+    all_meshes = all(p.shape.mesh is not None for p in body.parts) and all(o.shape.mesh is not None for o in obstacles)
     return RigidView(
         dimension=2 if body.space == "SE2" else 3,
         low=np.ascontiguousarray(low, dtype=float),
@@ -169,9 +173,8 @@ def build_view(
         solid=solid,
         corners_on_surface=np.array([_corners_on_surface(p.shape) for p in body.parts], dtype=bool),
         solid_box=np.array([o.shape.kind == "box" for o in obstacles], dtype=bool),
-        fine=not (
-            all(p.shape.mesh is not None for p in body.parts) and all(o.shape.mesh is not None for o in obstacles)
-        ),
+        fine=not all_meshes,
+        probe=all_meshes,
         clearance=float(clearance),
         handover=HANDOVER * reach,
         scale=max(1.0, reach),
@@ -248,6 +251,25 @@ def sphere_bound(view: RigidView, pose: np.ndarray, pair: int) -> float:  # prag
     o, g = pair // parts, pair % parts
     x, y, z = _placed(pose, view.part_centre[g])
     return _point_bound(view, o, x, y, z) - view.part_radius[g] - SLACK
+
+
+@njit(cache=True, inline="always")
+def swept_bound(view: RigidView, start: np.ndarray, end: np.ndarray, o: int) -> float:  # pragma: no cover
+    """Lower bound on obstacle ``o``'s distance from the whole body over a motion whose frame
+    origin moves straight from pose ``start`` to pose ``end`` (4, 4), turning any way on the way:
+    every point of the body stays within ``body_radius`` of that segment. From the obstacle's
+    sphere (its centre's distance from the segment) and its box (from the segment's middle,
+    less half its length), less :data:`~ompl_balance.collision.screening.SLACK`."""
+    ax, ay, az = start[0, 3], start[1, 3], start[2, 3]
+    ux, uy, uz = end[0, 3] - ax, end[1, 3] - ay, end[2, 3] - az
+    cx, cy, cz = view.obstacle_centre[o, 0] - ax, view.obstacle_centre[o, 1] - ay, view.obstacle_centre[o, 2] - az
+    length_squared = ux * ux + uy * uy + uz * uz
+    s = 0.0 if length_squared == 0.0 else min(max((cx * ux + cy * uy + cz * uz) / length_squared, 0.0), 1.0)
+    dx, dy, dz = cx - s * ux, cy - s * uy, cz - s * uz
+    sphere = math.sqrt(dx * dx + dy * dy + dz * dz) - view.obstacle_radius[o]
+    mx, my, mz = ax + 0.5 * ux, ay + 0.5 * uy, az + 0.5 * uz
+    box = _box_gap(view.box_centre, view.box_axes, view.box_half, o, mx, my, mz) - 0.5 * math.sqrt(length_squared)
+    return max(sphere, box) - view.body_radius - SLACK
 
 
 @njit(cache=True)
