@@ -134,15 +134,15 @@ def prepared(solve: Solve, layout: SpaceLayout, room: int, engine: str, name: st
         else:
             ou.OMPL_WARN(f"{name}: the compiled engine failed to compile ({failure}); solving on Python")
         return None
-    return partial(_run, solve, checks, layout, room)
+    return partial(_run, solve, checks, layout, key, room)
 
 
 def _run(
-    solve: Solve, checks: EngineChecks, layout: SpaceLayout, room: int, ptc: ob.PlannerTerminationCondition
+    solve: Solve, checks: EngineChecks, layout: SpaceLayout, key: Any, room: int, ptc: ob.PlannerTerminationCondition
 ) -> tuple[Any, str]:
     from .driver import run
 
-    return run(solve, ptc, checks, layout, room), checks.path
+    return run(solve, ptc, checks, layout, key, room), checks.path
 
 
 def _describe(checks: EngineChecks) -> str:

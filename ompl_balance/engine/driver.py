@@ -29,9 +29,9 @@ from ..policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCau
 from . import loop
 from .events import Grow, GrowStep, TreeChoiceEvent
 from .index import grown, new_index
-from .loading import view_key
 from .loop import Real, Record, Slot, Stop
 from .solve import Solve
+from .uniforms import bit_generator_address
 from .views import EngineChecks
 
 #: A slice of iterations lasts this long (ns, and the iteration under way at its end): the
@@ -120,11 +120,11 @@ class _Arrays:
 _RUNNERS: dict[Any, Callable[..., int]] = {}
 
 
-def _runner(*arguments: Any) -> Callable[..., int]:
+def _runner(key: Any, *arguments: Any) -> Callable[..., int]:
     """:func:`ompl_balance.engine.loop.run` for the types of ``arguments``, called without numba's
     type dispatch (tens of microseconds a call; working the types out takes milliseconds, so it
-    is done once per kind of view and layout)."""
-    key = view_key(arguments[:2])
+    is done once per kind of view and layout: ``key``, the view's and layout's
+    :func:`~ompl_balance.engine.loading.view_key`)."""
     if key not in _RUNNERS:
         _RUNNERS[key] = entry_point(loop.run, arguments)
     return _RUNNERS[key]
@@ -165,9 +165,10 @@ def interrupts_between_slices() -> Iterator[Callable[[], None]]:
 
 
 def run(
-    solve: Solve, ptc: ob.PlannerTerminationCondition, checks: EngineChecks, layout: SpaceLayout, room: int
+    solve: Solve, ptc: ob.PlannerTerminationCondition, checks: EngineChecks, layout: SpaceLayout, key: Any, room: int
 ) -> ob.PlannerStatus.PlannerStatusType:
-    """The loop of ``solve`` on the compiled engine, as :func:`ompl_balance.engine.python_loop.run`."""
+    """The loop of ``solve`` on the compiled engine, as :func:`ompl_balance.engine.python_loop.run`
+    (``key``: the :func:`~ompl_balance.engine.loading.view_key` of ``checks.view`` and ``layout``)."""
     settings = settings_of(solve)
     arrays = _Arrays(solve, layout, room, settings.record)
     ints, reals = arrays.loop.ints, arrays.loop.reals
@@ -178,7 +179,8 @@ def run(
     reals[Real.TREE_GAP] = solve.tree_gap
     exits_before = int(checks.view.counts[Count.EXITS])
     status = ob.PlannerStatus.TIMEOUT
-    run_slice = _runner(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, SLICE_NS)
+    bits = bit_generator_address(solve.rng)  # (solve keeps the generator alive)
+    run_slice = _runner(key, checks.view, layout, settings, arrays.trees, arrays.loop, bits, SLICE_NS)
 
     def feed_goal() -> bool:
         """The goal state the next iteration asks for, fed; ``False`` when there is none."""
@@ -197,7 +199,7 @@ def run(
                     break
                 ints[Slot.SAMPLED_GOALS] = solve.inputs.getSampledGoalsCount()
                 ints[Slot.MORE_GOALS] = solve.inputs.haveMoreGoalStates()
-                stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, solve.rng, SLICE_NS)
+                stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, bits, SLICE_NS)
                 arrays.adopt()
                 raise_interrupt()
                 solve.progress.iterations = int(ints[Slot.ITERATIONS])
@@ -273,4 +275,5 @@ def warm_up(view: object, layout: SpaceLayout) -> None:
         record=np.empty((0, Record.COUNT), dtype=np.int64),
         record_target=np.empty((0, dim)),
     )
-    loop.run(view, layout, settings, (tree, tree), arrays, np.random.default_rng(0), 0)
+    rng = np.random.default_rng(0)
+    loop.run(view, layout, settings, (tree, tree), arrays, bit_generator_address(rng), 0)

@@ -33,6 +33,7 @@ from ..core.layout import SpaceLayout
 from .clock import monotonic_ns
 from .events import Grow
 from .index import KDIndex, indexed_nearest
+from .uniforms import next_double
 
 register_jitable(policies.tree_size_ratio)  # callable from the compiled choose_tree
 choose_tree = njit(cache=True)(policies.choose_tree)
@@ -158,12 +159,13 @@ _CHOICE, _EXTENSION, _CONNECT_STEP = 0, 1, 2  # kinds of row in the loop record
 
 
 @njit(cache=True)
-def _uniform(layout: SpaceLayout, loop: Loop, rng: Any) -> np.ndarray:  # pragma: no cover (compiled)
-    """The next uniform sample (a row of the block, refilled as the Python engine refills its own)."""
+def _uniform(layout: SpaceLayout, loop: Loop, bits: int) -> np.ndarray:  # pragma: no cover (compiled)
+    """The next uniform sample (a row of the block, refilled as the Python engine refills its own
+    from the same generator: ``bits`` is its address, :mod:`ompl_balance.engine.uniforms`)."""
     if loop.ints[Slot.NEXT_SAMPLE] == loop.block.shape[0]:
         for row in range(loop.uniforms.shape[0]):
             for k in range(loop.uniforms.shape[1]):
-                loop.uniforms[row, k] = rng.random()
+                loop.uniforms[row, k] = next_double(bits)
         for row in range(loop.block.shape[0]):
             sample_from_uniforms(layout, loop.uniforms[row], loop.block[row])
         loop.ints[Slot.NEXT_SAMPLE] = 0
@@ -317,27 +319,27 @@ def _update_costs(layout: SpaceLayout, trees: tuple[Tree, Tree], loop: Loop, t: 
 
 @njit(cache=True)
 def _target(
-    layout: SpaceLayout, settings: Settings, trees: tuple[Tree, Tree], loop: Loop, rng: Any, t: int
+    layout: SpaceLayout, settings: Settings, trees: tuple[Tree, Tree], loop: Loop, bits: int, t: int
 ) -> tuple[np.ndarray, int, bool]:  # pragma: no cover (compiled)
     """The iteration's target (a row of ``loop.block`` or of a tree), the node to extend when
     the policy found it (``NO_NODE``: look it up), and ``False`` when the policy gave up."""
     policy = settings.sample_policy
     if policy == _UNIFORM:
-        return _uniform(layout, loop, rng), NO_NODE, True
+        return _uniform(layout, loop, bits), NO_NODE, True
     other = trees[1 - t]
     if policy == _GOAL_BIAS:
-        if rng.random() < settings.goal_bias:
+        if next_double(bits) < settings.goal_bias:
             return other.states[0], NO_NODE, True
-        return _uniform(layout, loop, rng), NO_NODE, True
+        return _uniform(layout, loop, bits), NO_NODE, True
     # goal_ball and neighbour_quality: uniform targets at uniform_rate keep them complete
-    if settings.uniform_rate > 0.0 and rng.random() < settings.uniform_rate:
-        return _uniform(layout, loop, rng), NO_NODE, True
+    if settings.uniform_rate > 0.0 and next_double(bits) < settings.uniform_rate:
+        return _uniform(layout, loop, bits), NO_NODE, True
     start, goal = trees[START].states[0], trees[GOAL].states[0]
     if policy == _GOAL_BALL:
         centre = other.states[0]
         radius = distance(layout, start, goal)
         for _ in range(_SAMPLE_ATTEMPTS):
-            point = _uniform(layout, loop, rng)
+            point = _uniform(layout, loop, bits)
             if distance(layout, point, centre) <= radius:
                 return point, NO_NODE, True
             loop.ints[Slot.REJECTIONS] += 1
@@ -346,10 +348,10 @@ def _target(
     tree = trees[t]
     optimal = distance(layout, start, goal)
     for _ in range(_SAMPLE_ATTEMPTS):
-        point = _uniform(layout, loop, rng)
+        point = _uniform(layout, loop, bits)
         node, _gap = _find_nearest(settings, layout, tree, loop.sizes[t], point)
         quality = node_quality(tree.costs[node], optimal, loop.reals[Real.START_COST_MAX + t], settings.min_quality)
-        if rng.random() < quality:
+        if next_double(bits) < quality:
             return point, node, True
         loop.ints[Slot.REJECTIONS] += 1
     return loop.target, NO_NODE, False
@@ -362,11 +364,13 @@ def run(
     settings: Settings,
     trees: tuple[Tree, Tree],
     loop: Loop,
-    rng: Any,
+    bits: int,
     slice_ns: int,
 ) -> int:  # pragma: no cover (compiled)
     """Run iterations of the loop for ``slice_ns`` nanoseconds (the iteration under way when they
-    are over finishes; ``slice_ns <= 0``: none); returns why it stopped (:class:`Stop`)."""
+    are over finishes; ``slice_ns <= 0``: none); returns why it stopped (:class:`Stop`). Random
+    numbers come from the numpy generator whose bit generator is at address ``bits``
+    (:func:`~ompl_balance.engine.uniforms.bit_generator_address`)."""
     ints, sizes = loop.ints, loop.sizes
     room = ints[Slot.ROOM]
     deadline = monotonic_ns() + slice_ns
@@ -418,7 +422,7 @@ def run(
         t = START if grow_start else GOAL
         o = 1 - t
 
-        target, given, found = _target(layout, settings, trees, loop, rng, t)
+        target, given, found = _target(layout, settings, trees, loop, bits, t)
         if not found:
             continue
         node, gap = _node_towards(settings, layout, trees, loop, t, target, given)
