@@ -174,6 +174,36 @@ def hull_bounds(
 
 
 @njit(cache=True, inline="always")
+def _table_axis(
+    a: np.ndarray, delta: np.ndarray, t0: float, chain: Chain, volumes: Volumes, table: int, k: int
+) -> tuple[float, float, float, float]:  # pragma: no cover (compiled)
+    """Axis ``k`` of certified-free table ``table`` along ``a + t delta``: the cell coordinate
+    ``u(t) = low + t slope`` as ``(low, slope)``, the first ``t`` after ``t0`` where ``u``
+    crosses a cell boundary, and the ``t`` between crossings (inf: ``u`` is constant)."""
+    joint = volumes.table_joints[table, k]
+    value = chain.multiplier[joint] * a[chain.source[joint]] + chain.shift[joint]
+    rate = chain.multiplier[joint] * delta[chain.source[joint]]
+    low = (value - volumes.table_low[table, k]) / volumes.table_cell[table, k]
+    slope = rate / volumes.table_cell[table, k]
+    u = low + t0 * slope
+    if slope > 0.0:
+        return low, slope, t0 + (math.floor(u) + 1.0 - u) / slope, 1.0 / slope
+    if slope < 0.0:
+        return low, slope, t0 + (math.ceil(u) - 1.0 - u) / slope, -1.0 / slope
+    return low, slope, np.inf, np.inf
+
+
+@njit(cache=True, inline="always")
+def _table_cell(u: float, cells: int) -> int:  # pragma: no cover (compiled)
+    """The cell of coordinate ``u`` on an axis of ``cells`` cells (the upper bound itself in the
+    last, closed, cell); -1 outside."""
+    cell = math.floor(u)
+    if cell == cells and u <= cells + 1e-9:
+        return cells - 1
+    return cell if 0 <= cell < cells else -1
+
+
+@njit(cache=True, inline="always")
 def table_span_free(
     a: np.ndarray, delta: np.ndarray, t0: float, t1: float, chain: Chain, volumes: Volumes, table: int
 ) -> bool:  # pragma: no cover (compiled)
@@ -182,44 +212,25 @@ def table_span_free(
     In the table's two joint values the edge is a straight line ``u(t)`` (in cells);
     between consecutive crossings of cell boundaries it stays in one closed cell, tested
     at the middle of the stretch. (A crossing ``t`` off by rounding moves by far less than
-    the tables' slack of :data:`~ompl_balance.collision.screening.SLACK`.)
+    the tables' slack of :data:`~ompl_balance.collision.screening.SLACK`.) Scalars only: it
+    runs for every self pair a segment does not certify, so allocations would cost more
+    than the walk.
     """
-    low, slope = np.empty(2), np.empty(2)
-    following, step = np.empty(2), np.empty(2)
-    cells = volumes.table_cells[table]
-    for k in range(2):
-        joint = volumes.table_joints[table, k]
-        value = chain.multiplier[joint] * a[chain.source[joint]] + chain.shift[joint]
-        rate = chain.multiplier[joint] * delta[chain.source[joint]]
-        low[k] = (value - volumes.table_low[table, k]) / volumes.table_cell[table, k]
-        slope[k] = rate / volumes.table_cell[table, k]
-        u = low[k] + t0 * slope[k]
-        if slope[k] > 0.0:
-            following[k] = t0 + (math.floor(u) + 1.0 - u) / slope[k]
-            step[k] = 1.0 / slope[k]
-        elif slope[k] < 0.0:
-            following[k] = t0 + (math.ceil(u) - 1.0 - u) / slope[k]
-            step[k] = -1.0 / slope[k]
-        else:
-            following[k], step[k] = np.inf, np.inf
+    rows, columns = volumes.table_cells[table, 0], volumes.table_cells[table, 1]
+    low_row, slope_row, next_row, step_row = _table_axis(a, delta, t0, chain, volumes, table, 0)
+    low_column, slope_column, next_column, step_column = _table_axis(a, delta, t0, chain, volumes, table, 1)
     begin = t0
     while begin < t1:
-        end = min(following[0], following[1], t1)
+        end = min(next_row, next_column, t1)
         middle = 0.5 * (begin + end)
-        index = volumes.table_start[table]
-        for k in range(2):
-            u = low[k] + middle * slope[k]
-            cell = math.floor(u)
-            if cell == cells[k] and u <= cells[k] + 1e-9:
-                cell = cells[k] - 1  # the upper bound itself: in the last (closed) cell
-            if cell < 0 or cell >= cells[k]:
-                return False
-            index += cell * cells[1] if k == 0 else cell
-        if not volumes.table_free[index]:
+        row = _table_cell(low_row + middle * slope_row, rows)
+        column = _table_cell(low_column + middle * slope_column, columns)
+        if row < 0 or column < 0 or not volumes.table_free[volumes.table_start[table] + row * columns + column]:
             return False
-        for k in range(2):
-            if following[k] <= end:
-                following[k] += step[k]
+        if next_row <= end:
+            next_row += step_row
+        if next_column <= end:
+            next_column += step_column
         begin = end
     return True
 
