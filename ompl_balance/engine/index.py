@@ -134,8 +134,9 @@ def new_index(layout: SpaceLayout, capacity: int) -> KDIndex:
 
 
 def grown(index: KDIndex, capacity: int) -> KDIndex:
-    """``index`` with room for ``capacity`` nodes (itself when it has that room)."""
-    if len(index.order) >= capacity:
+    """``index`` with room for ``capacity`` nodes (itself when it has that room, or when it has no
+    axes: then the tree is scanned and the index's node arrays are never used)."""
+    if len(index.order) >= capacity or index.ints[Setting.AXES] == 0:
         return index
 
     def more(array: np.ndarray) -> np.ndarray:

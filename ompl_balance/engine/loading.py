@@ -49,9 +49,26 @@ def view_key(value: Any) -> Any:
 _KEYS: dict[int, tuple[Any, Any]] = {}  # id -> (the value, its key), the value kept so its id is not reused
 
 
+class _Key:
+    """A named tuple's key with its hash worked out once: a robot view's key holds hundreds of
+    items, and a solve looks it up in several tables."""
+
+    __slots__ = ("_hash", "items")
+
+    def __init__(self, items: tuple[Any, ...]) -> None:
+        self.items = items
+        self._hash = hash(items)
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    def __eq__(self, other: object) -> bool:
+        return self is other or (isinstance(other, _Key) and self._hash == other._hash and self.items == other.items)
+
+
 def _view_key(value: Any) -> Any:
     if isinstance(value, tuple) and hasattr(value, "_fields"):
-        return (type(value), tuple(view_key(field) for field in value))
+        return _Key((type(value), tuple(view_key(field) for field in value)))
     if isinstance(value, tuple):
         return tuple(view_key(item) for item in value)
     if isinstance(value, np.ndarray):
