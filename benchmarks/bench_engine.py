@@ -22,8 +22,12 @@ the engines' speed alone.
 ``profile``
     Where a compiled solve's time goes on the Panda problems: the certified edges and state
     checks in compiled code (the edges and states of the same runs, replayed through the
-    kernels), the calls out to Python (FCL on pairs the kernels cannot decide, timed), and the
-    rest (the loop: nearest nodes, sampling, trees; slices and their Python).
+    kernels), the calls out to Python (FCL on pairs the kernels cannot decide, timed), the rest
+    of the compiled slices (the loop: nearest nodes, sampling, trees), and the Python around the
+    slices (the planner's solve before and after the loop: start and goal states through OMPL,
+    the arrays, the path, the statistics), and ``SimpleSetup.solve`` around the planner (with a
+    time limit of a second or more, OMPL evaluates it in a thread of its own, which the solve
+    waits for at its end).
 ``scaling``
     The cost of an iteration as the trees grow to tens of thousands of nodes, in R^2 and SE(3)
     (a box world and a rigid body, each cut in two by a wall so that both trees grow freely
@@ -54,6 +58,7 @@ from ompl_balance.collision.checker import CollisionChecker
 from ompl_balance.collision.environment import Environment
 from ompl_balance.collision.robots import load_panda_vamp
 from ompl_balance.core.counting import CountingValidityChecker, measured_solve
+from ompl_balance.engine import driver
 from ompl_balance.worlds.boxes import BoxWorld2D, Problem, get_problem
 from ompl_balance.worlds.mbm import SCENARIOS, MBMProblem, load_mbm
 from ompl_balance.worlds.rigid import RigidBodyProblem, shipped_robot
@@ -228,27 +233,56 @@ def timed_exits() -> Iterator[list[float]]:
         CollisionChecker.decide, certified.MotionCertifier.hard_segments_free = decide, hard
 
 
-def seeded_solve(robot, problem: MBMProblem, engine: str, seed: int, time_limit: float) -> float:
+@contextlib.contextmanager
+def timed_slices() -> Iterator[list[float]]:
+    """Seconds spent inside the compiled loop's slices (kernels and exits included) while inside, in ``[0]``."""
+    spent = [0.0]
+    runner = driver._runner
+
+    def timed_runner(*arguments):
+        run_slice = runner(*arguments)
+
+        def timed(*slice_arguments):
+            began = time.perf_counter()
+            try:
+                return run_slice(*slice_arguments)
+            finally:
+                spent[0] += time.perf_counter() - began
+
+        return timed
+
+    driver._runner = timed_runner
+    try:
+        yield spent
+    finally:
+        driver._runner = runner
+
+
+def seeded_solve(robot, problem: MBMProblem, engine: str, seed: int, time_limit: float) -> tuple[float, float]:
+    """``ss.solve``'s time and the planner's own (``planner.stats.time``), in seconds."""
     ss = problem.simple_setup(robot, CollisionChecker(robot, problem.environment))
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     planner.setEngine(engine)
     planner.setSeed(seed)
     ss.setPlanner(planner)
-    return measured_solve(ss, time_limit).time
+    return measured_solve(ss, time_limit).time, planner.stats.time
 
 
-def profile_problem(robot, problem: MBMProblem, time_limit: float, replay: Callable) -> tuple[float, float, float, int]:
-    """A compiled solve's time, its time in calls out to Python, its edges' and states' time in the
-    kernels, and its edges. The Python engine on the same seed makes the same trees, so its
-    validator's calls are the compiled engine's edges and states."""
+def profile_problem(
+    robot, problem: MBMProblem, time_limit: float, replay: Callable
+) -> tuple[float, float, float, float, float, int]:
+    """A compiled solve's time (``ss.solve``'s and the planner's own), its time in calls out to
+    Python, its edges' and states' time in the kernels, its time inside the compiled slices, and
+    its edges. The Python engine on the same seed makes the same trees, so its validator's calls
+    are the compiled engine's edges and states."""
     seed = 1 + problem.id
     with recorded_checks() as (edges, states):
         seeded_solve(robot, problem, "python", seed, time_limit)
-    with timed_exits() as spent:
-        solve_time = seeded_solve(robot, problem, "compiled", seed, time_limit)
-    exit_time = spent[0]
+    with timed_exits() as spent, timed_slices() as sliced:
+        solve_time, planner_time = seeded_solve(robot, problem, "compiled", seed, time_limit)
+    exit_time, slice_time = spent[0], sliced[0]
     if not edges:
-        return solve_time, exit_time, 0.0, 0
+        return solve_time, planner_time, exit_time, 0.0, slice_time, 0
     certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))  # (the view's exits)
     view = certifier.compiled_view()
     starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
@@ -257,7 +291,7 @@ def profile_problem(robot, problem: MBMProblem, time_limit: float, replay: Calla
         began = time.perf_counter()
         replay(view, starts, ends, np.array(states).reshape(-1, robot.dof))
         kernel_time = time.perf_counter() - began - spent[0]
-    return solve_time, exit_time, kernel_time, len(edges)
+    return solve_time, planner_time, exit_time, kernel_time, slice_time, len(edges)
 
 
 def profile(args) -> None:
@@ -279,17 +313,22 @@ def profile(args) -> None:
     print(f"\nWhere a compiled solve's time goes: first {args.problems} problems per scenario, certified motions\n")
     print(
         "| scenario | solve time (ms, total) | edges and states in compiled code | calls out to Python (FCL) "
-        "| the loop and its slices | us / edge (kernel) |\n|---|---|---|---|---|---|"
+        "| the compiled loop (nearest nodes, samples, trees) | the planner's Python around the slices "
+        "(ms per solve) | SimpleSetup around the planner (ms per solve) | us / edge (kernel) |"
+        "\n|---|---|---|---|---|---|---|---|"
     )
     for scenario in SCENARIOS:
-        totals = np.zeros(4)
-        for problem in load_mbm(scenario, robot.joint_names)[: args.problems]:
+        totals = np.zeros(6)
+        problems = load_mbm(scenario, robot.joint_names)[: args.problems]
+        for problem in problems:
             totals += profile_problem(robot, problem, args.time_limit, replay)
-        solve_time, exit_time, kernel_time, edges = totals
-        rest = solve_time - exit_time - kernel_time
+        solve_time, planner_time, exit_time, kernel_time, slice_time, edges = totals
+        loop_time = slice_time - exit_time - kernel_time
+        around, outside = planner_time - slice_time, solve_time - planner_time
+        shares = [f"{seconds / solve_time:.0%}" for seconds in (kernel_time, exit_time, loop_time)]
+        shares += [f"{seconds / solve_time:.0%} ({seconds / len(problems) * 1e3:.2f})" for seconds in (around, outside)]
         print(
-            f"| {scenario} | {solve_time * 1e3:.0f} | {kernel_time / solve_time:.0%} | {exit_time / solve_time:.0%} "
-            f"| {rest / solve_time:.0%} | {kernel_time / max(edges, 1) * 1e6:.0f} |",
+            f"| {scenario} | {solve_time * 1e3:.0f} | {' | '.join(shares)} | {kernel_time / max(edges, 1) * 1e6:.0f} |",
             flush=True,
         )
 
