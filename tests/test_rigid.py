@@ -363,7 +363,7 @@ def test_grazing_and_touching_edges_terminate_and_are_refused():
 # -- the compiled view ----------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit
 def _loop(view, states):  # what an engine's compiled loop does: kernels on the view, no Python
     status = np.empty(len(states), dtype=np.int64)
     for i in range(len(states)):

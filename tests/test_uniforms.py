@@ -9,7 +9,7 @@ from numba import njit
 from ompl_balance.engine.uniforms import bit_generator_address, next_double
 
 
-@njit(cache=True)
+@njit
 def _draw(address: int, count: int) -> np.ndarray:  # pragma: no cover (compiled)
     out = np.empty(count)
     for i in range(count):

@@ -29,8 +29,8 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from ..core.kernel_cache import njit
 from .convex import ConvexParts, Vector, distance_bounds
 from .kinematics import Chain, chain_poses
 from .screening import SLACK, Volumes

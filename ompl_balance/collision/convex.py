@@ -57,7 +57,8 @@ from typing import NamedTuple
 
 import numpy as np
 import scipy.spatial
-from numba import njit
+
+from ..core.kernel_cache import njit
 
 #: GJK stops when its lower and upper bounds are within this many metres.
 GJK_TOLERANCE = 1e-9

@@ -24,11 +24,12 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
-from numba import njit, objmode
+from numba import objmode
 
 from ..core.check_overloads import register_kernels
 from ..core.checks import Count, exit_handle, exit_target
 from ..core.compiled_spaces import segment_count
+from ..core.kernel_cache import njit
 from ..core.layout import SpaceLayout
 from .advancement import EdgeModel, EdgeScratch, EndMemory, advance, memory_row
 from .kinematics import LIMIT_TOLERANCE, Chain

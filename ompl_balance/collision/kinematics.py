@@ -27,9 +27,9 @@ from urllib.parse import unquote, urlparse
 import numpy as np
 import trimesh
 import yourdfpy
-from numba import njit
 from numpy.typing import ArrayLike
 
+from ..core.kernel_cache import njit
 from .geometry import Shape
 from .urdf import check_urdf
 

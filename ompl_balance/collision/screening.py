@@ -35,8 +35,8 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import fcl
 import numpy as np
-from numba import njit
 
+from ..core.kernel_cache import njit
 from .cache import cached_arrays
 from .geometry import fcl_transform
 from .kinematics import Chain, RobotModel, _chain_poses_batch, chain_poses

@@ -18,8 +18,8 @@ numba compiles the signatures given to ``njit``.
 import math
 
 import numpy as np
-from numba import njit
 
+from .kernel_cache import njit
 from .layout import QUATERNION_TOLERANCE, Leaf, SpaceLayout
 
 _EPS = float(np.finfo(np.float64).eps)

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, objmode
+from numba import objmode
 
 from ..core.check_overloads import register_kernels
 from ..core.checks import Count, exit_handle, new_counts, state_free
 from ..core.compiled_spaces import interpolate, segment_count
+from ..core.kernel_cache import njit
 from .views import DiscreteMotions, PythonChecks, call_check_motion, call_is_valid
 
 

@@ -34,9 +34,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from ..core.compiled_spaces import is_euclidean, nearest, row_distance
+from ..core.kernel_cache import njit
 from ..core.layout import Leaf, SpaceLayout
 
 #: Trees with fewer nodes are scanned (the index does not pay).

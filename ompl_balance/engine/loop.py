@@ -23,12 +23,12 @@ import enum
 from typing import Any, NamedTuple
 
 import numpy as np
-from numba import njit
 from numba.extending import register_jitable
 
 from .. import policies
 from ..core.checks import motion_free, state_free
 from ..core.compiled_spaces import distance, equal, interpolate, row_distance, sample_from_uniforms, segment_count
+from ..core.kernel_cache import njit
 from ..core.layout import SpaceLayout
 from .clock import monotonic_ns
 from .events import Grow

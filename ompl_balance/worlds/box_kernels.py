@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ..core.check_overloads import register_kernels
 from ..core.checks import Count
+from ..core.kernel_cache import njit
 from .boxes import BoxKernel
 
 

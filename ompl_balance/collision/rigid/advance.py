@@ -32,9 +32,10 @@ the kernel always terminates.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
+from numba import types
 from numba.typed import Dict
 
+from ...core.kernel_cache import njit
 from ..advancement import DISTANCE_TOLERANCE, grown
 from .motion import interpolate, motion_split, state_pose, valid_state
 from .view import (

@@ -14,10 +14,11 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
-from numba import njit, objmode
+from numba import objmode
 
 from ...core.check_overloads import register_kernels
 from ...core.checks import Count, exit_handle, exit_target, kernels_in
+from ...core.kernel_cache import njit
 from .advance import edge_status
 from .motion import interpolate, motion_split
 from .view import BOUNDS_COMPUTED, FREE, POSES_EVALUATED, UNDECIDED, RigidView, state_status

@@ -20,7 +20,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from ...core.kernel_cache import njit
 
 #: OMPL's ``MAX_QUATERNION_NORM_ERROR``: quaternions closer than this to the same
 #: orientation (``|q_a . q_b| > 1 -`` this) are one orientation for OMPL's interpolation,

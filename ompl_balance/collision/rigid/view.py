@@ -28,8 +28,8 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-from numba import njit
 
+from ...core.kernel_cache import njit
 from ..convex import ConvexParts, convex_part, distance_bounds, pack_parts
 from ..screening import SLACK
 from .motion import state_pose, valid_state

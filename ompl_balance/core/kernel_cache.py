@@ -1,0 +1,88 @@
+"""numba's disk cache of the package's kernels, renewed whenever any of the package's source changes.
+
+numba keys a cached function by the source of its own file only. A kernel compiles in the
+kernels it calls from other modules (the certified edge calls GJK, the planning loop calls
+the checkers' kernels), so when only a callee's module changes, as after a ``git pull`` in a
+checkout installed in place, numba would load the caller's old machine code and run the old
+callee inside it, silently. Here every function defined in the package's files is cached
+with its file's stamp *and* a digest of all the package's Python sources: any change to the
+package compiles its kernels again (once, a minute or two), and no stale kernel ever runs.
+
+The package's kernel modules take :func:`njit` from here rather than from numba: importing this
+module puts :class:`PackageCacheLocator` first among numba's cache locators before any of them
+is decorated (numba picks a function's locator when it is decorated).
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+from pathlib import Path
+from typing import Any
+
+from numba import njit
+from numba.core import caching
+
+__all__ = ["PackageCacheLocator", "njit", "package_digest"]
+
+#: The package's folder: functions defined in files below it are cached by :class:`PackageCacheLocator`.
+PACKAGE = Path(__file__).resolve().parents[1]
+
+
+@functools.lru_cache(maxsize=1)
+def package_digest() -> str:
+    """SHA-256 of the package's Python sources (their paths and contents), worked out once a process."""
+    digest = hashlib.sha256()
+    for path in sorted(PACKAGE.rglob("*.py")):
+        digest.update(path.relative_to(PACKAGE).as_posix().encode())
+        digest.update(b"\0")
+        digest.update(path.read_bytes())
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def _in_package(py_file: str) -> bool:
+    try:
+        Path(py_file).resolve().relative_to(PACKAGE)
+    except (OSError, ValueError):
+        return False
+    return True
+
+
+class PackageCacheLocator(caching._CacheLocator):
+    """numba's own locator for a function defined in the package (where and under which name its
+    cache lives), with :func:`package_digest` added to the source stamp that decides whether a
+    cached entry is still good."""
+
+    def __init__(self, inner: Any) -> None:
+        self._inner = inner
+        self._py_file = getattr(inner, "_py_file", "")  # (numba's warnings read it)
+
+    def ensure_cache_path(self) -> None:
+        self._inner.ensure_cache_path()
+
+    def get_cache_path(self) -> str:
+        return str(self._inner.get_cache_path())
+
+    def get_source_stamp(self) -> Any:
+        return (self._inner.get_source_stamp(), package_digest())
+
+    def get_disambiguator(self) -> str:
+        return str(self._inner.get_disambiguator())
+
+    @classmethod
+    def from_function(cls, py_func: Any, py_file: str) -> PackageCacheLocator | None:
+        if not _in_package(py_file):
+            return None
+        for locator_class in _NUMBAS_LOCATORS:
+            inner = locator_class.from_function(py_func, py_file)
+            if inner is not None:
+                return cls(inner)
+        return None
+
+
+# numba's locators, in its order of preference (``CacheImpl``; ``_CacheImpl`` in older numba)
+_LOCATORS: list[Any] = (getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl"))._locator_classes  # noqa: B009
+_NUMBAS_LOCATORS = [locator for locator in _LOCATORS if locator is not PackageCacheLocator]
+if PackageCacheLocator not in _LOCATORS:
+    _LOCATORS.insert(0, PackageCacheLocator)
