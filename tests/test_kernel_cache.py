@@ -5,7 +5,6 @@ from __future__ import annotations
 import importlib
 import subprocess
 import sys
-import textwrap
 from pathlib import Path
 
 from numba.core.caching import FunctionCache
@@ -107,5 +106,5 @@ def _imports_njit(text: str) -> bool:
 
 def test_a_function_outside_the_package_keeps_numbas_locator(tmp_path) -> None:
     source = tmp_path / "outside.py"
-    source.write_text(textwrap.dedent("def h(x):\n    return x\n"))
+    source.write_text("def h(x):\n    return x\n")
     assert PackageCacheLocator.from_function(lambda x: x, str(source)) is None
