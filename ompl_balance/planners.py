@@ -34,14 +34,13 @@ from ompl import base as ob
 from ompl import util as ou
 
 from .core.counting import WorkCount
-from .core.layout import layout_for
+from .core.layout import has_layout
 from .core.params import Settings, param
 from .core.planner import GOAL_TAG, RANGE_AS_EXTENT_FRACTION, START_TAG, PlannerSpecs, TreePlanner
 from .core.spaces import ArrayPoints, Points
 from .core.trees import NO_PARENT, Tree
 from .engine import python_loop
-from .engine.compiled import CompiledRun, prepared, room_per_iteration
-from .engine.compiled import load as load_engine
+from .engine.compiled import CompiledEngine, CompiledRun, room_per_iteration
 from .engine.events import LoopCounts, LoopRecord
 from .engine.solve import Solve
 from .policies import (
@@ -251,6 +250,7 @@ class BalancedRRTConnect(TreePlanner):
         self.settings.update({**self.POLICIES, "intermediate_states": bool(addIntermediateStates)})
         self._valid_state_sampler_allocator: ValidStateSamplerAllocator | None = type(self).VALID_STATE_SAMPLER
         self._valid_sampler: ob.ValidStateSampler | None = None
+        self._engine = CompiledEngine()  # what compiled solves reuse
         # The trees and what the policies keep per node and between iterations: kept across
         # solves until clear().
         self._start_tree: Tree | None = None
@@ -286,6 +286,7 @@ class BalancedRRTConnect(TreePlanner):
         self._valid_sampler = None  # allocated again from the current allocator
         if self.settings.engine != "python" and not self._why_not_compiled():
             self._load_engine(wait=self.settings.engine == "compiled")
+        self._ready_trees()
 
     def wait_for_engine(self) -> None:
         """Make the compiled engine ready for this planner's solves now (after ``setup()``), as
@@ -293,14 +294,16 @@ class BalancedRRTConnect(TreePlanner):
         instead, and solves run on the Python engine until it is ready. Benchmarks call this
         so that every timed solve runs on the same engine. Nothing to do where the compiled
         engine does not apply."""
+        if self._points is None:  # (not set up)
+            self.setup()
         if self.settings.engine != "python" and not self._why_not_compiled():
             self._load_engine(wait=True)
+            self._ready_trees()
 
     def _load_engine(self, wait: bool) -> None:
-        si = self.getSpaceInformation()
-        layout = layout_for(si.getStateSpace())
-        assert layout is not None  # (checked by _why_not_compiled)
-        load_engine(si, layout, self.settings.engine, wait=wait)
+        points = self._points
+        assert isinstance(points, ArrayPoints)  # (checked by _why_not_compiled)
+        self._engine.load(self.getSpaceInformation(), points.layout, self.settings.engine, wait=wait)
 
     def _check_policies(self) -> None:
         """Refuse combinations of policies and parameters that cannot do what they say."""
@@ -322,7 +325,7 @@ class BalancedRRTConnect(TreePlanner):
             return "sample_policy=valid_sampler (a valid-state sampler is an OMPL object called per sample)"
         space = self.getSpaceInformation().getStateSpace()
         if points is None:
-            if layout_for(space) is None:
+            if not has_layout(space):
                 return f"a {type(space).__name__} (it plans in real-vector, SO(2), SO(3), SE(2), SE(3) spaces and their compounds)"
         elif not isinstance(points, ArrayPoints):
             return f"a {type(space).__name__} (it plans in real-vector, SO(2), SO(3), SE(2), SE(3) spaces and their compounds)"
@@ -338,6 +341,21 @@ class BalancedRRTConnect(TreePlanner):
         self._swap_state = SwapState()
         self._connection = None
         self._distance_between_trees = math.inf
+        if self._points is not None:  # (set up)
+            self._ready_trees()
+
+    def _ready_trees(self) -> tuple[Tree, Tree]:
+        """The planner's trees (new, empty ones if it has none) and what the policies keep per
+        node; the compiled engine's arrays for them are made now where it is loaded (as OMPL's
+        planners allocate at setup and clear: a solve's time does not count them)."""
+        points = self._points
+        assert points is not None  # (set up)
+        if self._start_tree is None or self._goal_tree is None:
+            self._start_tree, self._goal_tree = points.new_tree(), points.new_tree()
+            self._failures = {self._start_tree: NodeFailures(), self._goal_tree: NodeFailures()}
+        if isinstance(points, ArrayPoints):
+            self._engine.prepare(points.layout, self._start_tree, self._goal_tree)
+        return self._start_tree, self._goal_tree
 
     # -- solving -------------------------------------------------------------------
 
@@ -346,10 +364,7 @@ class BalancedRRTConnect(TreePlanner):
     ) -> tuple[ob.PlannerStatus.PlannerStatusType, _LoopOutcome]:
         """The grow/connect loop on the engine the settings choose; returns the status and what it measured."""
         name = self.getName()
-        if self._start_tree is None or self._goal_tree is None:
-            self._start_tree, self._goal_tree = points.new_tree(), points.new_tree()
-            self._failures = {self._start_tree: NodeFailures(), self._goal_tree: NodeFailures()}
-        start_tree, goal_tree = self._start_tree, self._goal_tree
+        start_tree, goal_tree = self._ready_trees()
 
         def result(
             status: ob.PlannerStatus.PlannerStatusType,
@@ -466,7 +481,7 @@ class BalancedRRTConnect(TreePlanner):
                     f"{room} nodes; use a larger range or engine=python"
                 )
             return None
-        return prepared(solve, points.layout, room, settings.engine, self.getName())
+        return self._engine.run_of(solve, points.layout, room, settings.engine, self.getName())
 
     def _progress_extras(self) -> dict[str, Callable[[], str]]:
         return {

@@ -34,14 +34,27 @@ COMPILED_PRESETS = [name for name in PRESETS if name != "GaussianPassageRRTConne
 IGNORED = {"time", "engine", "checks", "exits"}
 
 
-def solve(make_setup, engine, planner_class=BalancedRRTConnect, seed=3, params=None, limit=20.0, solves=1, **kwargs):
-    """Solve ``make_setup()`` on ``engine`` ``solves`` times in a row; returns (stats, trees, path) per solve."""
+def solve(
+    make_setup,
+    engine,
+    planner_class=BalancedRRTConnect,
+    seed=3,
+    params=None,
+    limit=20.0,
+    solves=1,
+    between=(),
+    **kwargs,
+):
+    """Solve ``make_setup()`` on ``engine`` ``solves`` times in a row (``between[i](ss, planner)``
+    called before solve ``i + 1``); returns (stats, trees, path) per solve."""
     ss = make_setup()
     planner = planner_class(ss.getSpaceInformation(), **kwargs)
     assert planner.params().setParams({"engine": engine, "seed": str(seed), **(params or {})})
     ss.setPlanner(planner)
     outcomes = []
-    for _ in range(solves):
+    for index in range(solves):
+        if index > 0 and index - 1 < len(between):
+            between[index - 1](ss, planner)
         status = ss.solve(limit)
         stats = {key: value for key, value in planner.stats.as_dict().items() if key not in IGNORED}
         assert planner.stats.engine == engine
@@ -107,6 +120,33 @@ def test_intermediate_states_and_repeated_solves_without_clear():
     compiled = solve(make, "compiled", solves=3, **kwargs)
     assert_same_run(python, compiled)
     assert python[2][1]["start_tree_size"] > python[0][1]["start_tree_size"]  # the trees carry over
+
+
+def finer_resolution(ss, planner):
+    si = ss.getSpaceInformation()
+    si.setStateValidityCheckingResolution(0.002)
+    si.setup()
+
+
+def test_changes_between_solves_reach_the_compiled_engine():
+    """The compiled engine keeps its check view, arrays and loop settings from one solve to the
+    next; a finer validity-checking resolution (after ``si.setup()``), a new range, a recorded
+    run and a ``clear()`` must reach it as they reach the Python engine."""
+    from ompl_balance.engine.events import LoopRecord
+
+    def record(ss, planner):
+        planner.loop_record = LoopRecord()
+
+    def shorter_range(ss, planner):
+        planner.params().setParam("range", "0.04")
+
+    changes = (finer_resolution, shorter_range, record, lambda ss, planner: ss.clear())
+    make = get_problem("narrow_gap").setup
+    python = solve(make, "python", solves=5, between=changes)
+    compiled = solve(make, "compiled", solves=5, between=changes)
+    assert_same_run(python, compiled)
+    checks_per_motion = [run[1]["states_checked"] / max(run[1]["motions_checked"], 1) for run in python]
+    assert checks_per_motion[1] > checks_per_motion[0]  # (the finer resolution checks more states a motion)
 
 
 def several_goals_setup():

@@ -103,6 +103,11 @@ def _leaves(space: ob.StateSpace, weight: float, out: list[tuple[Leaf, float, ob
     return True
 
 
+def has_layout(space: ob.StateSpace) -> bool:
+    """Whether ``space`` has a flat layout (what :func:`layout_for` asks first, without building it)."""
+    return _leaves(space, 1.0, [])
+
+
 def layout_for(space: ob.StateSpace) -> SpaceLayout | None:
     """The flat layout of a set-up OMPL ``space``, or ``None`` when it has none (another kind of space)."""
     leaves: list[tuple[Leaf, float, ob.StateSpace]] = []

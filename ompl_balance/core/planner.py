@@ -171,7 +171,7 @@ class TreePlanner(ob.Planner):
         self.settings: Any = type(self).Settings()
         self._params = ParamSet.of(self.settings)
         self._rng = ou.RNG()  # per-planner stream, seeded from OMPL's global seed
-        self._points: Points | None = None  # how the last solve saw the space
+        self._points: Points | None = None  # how solves see the space (made at setup)
         self.progress = Progress()
         self.stats: Any = None
 
@@ -211,7 +211,9 @@ class TreePlanner(ob.Planner):
 
     def setup(self) -> None:
         super().setup()
-        ensure_counting(self.getSpaceInformation())
+        si = self.getSpaceInformation()
+        ensure_counting(si)
+        self._points = points_for(si)  # how solves see the space (each restarts it with its seed)
 
     def clear(self) -> None:
         super().clear()
@@ -226,7 +228,8 @@ class TreePlanner(ob.Planner):
         began = time.perf_counter()
         work_before = read_work(si)
         rng = np.random.default_rng(self.settings.seed or self._draw_seed())
-        self._points = points_for(si, rng)
+        # (how the last solve saw the space serves the next: allocating it costs a short solve's time)
+        self._points = points_for(si, rng) if self._points is None else self._points.restarted(rng)
         self.progress = Progress()
         status, measured = self._plan(ptc, self._points, rng)
         work = read_work(si) - work_before

@@ -49,16 +49,17 @@ class Points(Protocol):
     def ompl_state(self, point: Any, slot: int = 0) -> ob.State: ...
     def new_state(self, point: Any) -> ob.State: ...
     def segment_points(self, a: Any, b: Any) -> list[Any]: ...
+    def restarted(self, rng: np.random.Generator) -> Points: ...
 
 
 class ArrayPoints:
     """Points of a space with a flat layout as ``(dim,)`` float64 arrays."""
 
-    def __init__(self, si: ob.SpaceInformation, layout: SpaceLayout, rng: np.random.Generator) -> None:
+    def __init__(self, si: ob.SpaceInformation, layout: SpaceLayout, rng: np.random.Generator | None = None) -> None:
         self.layout = layout
         self.dim = layout.dim
         self._euclidean = layout.euclidean
-        self._rng = rng
+        self._rng = rng  # None: set by restarted() before the first sample
         self._block = np.empty((0, self.dim))
         self._next = 0
         self._space = si.getStateSpace()
@@ -66,6 +67,19 @@ class ArrayPoints:
         self._read = state_reader(self._space)
         # Two scratch OMPL states: checks take a pair (nearest, new) at a time.
         self._scratch = (si.allocState(), si.allocState())
+        self._space_measures = _layout_measures(self._space)
+        self._largest = max(float(np.abs(layout.low).max(initial=0.0)), float(np.abs(layout.high).max(initial=0.0)))
+
+    def restarted(self, rng: np.random.Generator) -> Points:
+        """These points, drawing from ``rng`` from now on (a fresh block of samples), for the next
+        solve; new points when the space's extent or validity-checking resolution changed since
+        these were made (a ``si.setup()`` after a change), so that the layout is the space's own."""
+        if _layout_measures(self._space) != self._space_measures:
+            return points_for(self._si, rng)
+        self._rng = rng
+        self._block = self._block[:0]
+        self._next = 0
+        return self
 
     def new_tree(self) -> ArrayTree:
         return ArrayTree(self.dim, layout=self.layout)
@@ -73,6 +87,7 @@ class ArrayPoints:
     def sample(self) -> np.ndarray:
         """A uniform sample of the space, ``(dim,)`` (a view into the current block of samples)."""
         if self._next == len(self._block):
+            assert self._rng is not None, "restarted(rng) before sampling"
             uniforms = self._rng.random((SAMPLE_BLOCK, self.layout.total_draws))
             self._block = flat.samples_from_uniforms(self.layout, uniforms)
             self._next = 0
@@ -111,8 +126,7 @@ class ArrayPoints:
         """
         if not self._euclidean:
             return True
-        largest = max(float(np.abs(self.layout.low).max(initial=0.0)), float(np.abs(self.layout.high).max(initial=0.0)))
-        return step <= 4.0 * _EQUAL_TOLERANCE * largest * math.sqrt(self.dim)
+        return step <= 4.0 * _EQUAL_TOLERANCE * self._largest * math.sqrt(self.dim)
 
     def is_finite(self, state: ob.State) -> bool:
         """``False`` when an OMPL state has a NaN or infinite value (bounds checks miss NaN)."""
@@ -152,14 +166,21 @@ class StatePoints:
     def __init__(self, si: ob.SpaceInformation) -> None:
         self._si = si
         self._space = si.getStateSpace()
-        self._sampler = si.allocStateSampler()
+        self._sampler: ob.StateSampler | None = None  # allocated at the first sample
         self.distance = si.distance
         self.equal = si.equalStates
+
+    def restarted(self, rng: np.random.Generator) -> Points:
+        """Points with a sampler of their own for the next solve (allocated from OMPL, which
+        seeds it from its RNG, as each solve's sampler always was; ``rng`` is not used)."""
+        return StatePoints(self._si)
 
     def new_tree(self) -> StateTree:
         return StateTree(self._si)
 
     def sample(self) -> ob.State:
+        if self._sampler is None:
+            self._sampler = self._si.allocStateSampler()
         state = self._si.allocState()
         self._sampler.sampleUniform(state)
         return state
@@ -200,7 +221,13 @@ class StatePoints:
         return [self.interpolate(a, b, step / count) for step in range(1, count)] + [self.new_state(b)]
 
 
-def points_for(si: ob.SpaceInformation, rng: np.random.Generator) -> Points:
-    """Flat arrays for the spaces with a layout (:mod:`ompl_balance.core.layout`), OMPL states otherwise."""
+def _layout_measures(space: ob.StateSpace) -> tuple[float, float]:
+    """What a change of a space's bounds or validity-checking resolution changes (cheap to read)."""
+    return space.getMaximumExtent(), space.getLongestValidSegmentLength()
+
+
+def points_for(si: ob.SpaceInformation, rng: np.random.Generator | None = None) -> Points:
+    """Flat arrays for the spaces with a layout (:mod:`ompl_balance.core.layout`), OMPL states otherwise;
+    samples come from ``rng`` (flat arrays; ``None``: from the generator given to ``restarted``)."""
     layout = layout_for(si.getStateSpace())
     return StatePoints(si) if layout is None else ArrayPoints(si, layout, rng)

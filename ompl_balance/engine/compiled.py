@@ -1,10 +1,10 @@
 """Whether a solve runs on the compiled engine, and running it.
 
-:func:`prepared` is what the planner asks before each solve: it builds the solve's check view
-(:mod:`ompl_balance.engine.views`), and returns the compiled engine's run when the engine for
-that kind of view is loaded in this process (or, with ``wait``, after loading it); otherwise it
-starts loading it in the background (:mod:`ompl_balance.engine.loading`) and returns ``None``,
-and the solve runs on the Python engine. Nothing here imports numba: a process that never
+:class:`CompiledEngine` is what a planner asks before each solve: it keeps the solves' check
+view (:mod:`ompl_balance.engine.views`), and returns the compiled engine's run when the engine
+for that kind of view is loaded in this process (or, with ``engine=compiled``, after loading
+it); otherwise it starts loading it in the background (:mod:`ompl_balance.engine.loading`) and
+returns ``None``, and the solve runs on the Python engine. Nothing here imports numba: a process that never
 plans on the compiled engine never loads it.
 """
 
@@ -27,6 +27,7 @@ from ompl import util as ou
 
 from ..core.checks import kernel_modules
 from ..core.layout import SpaceLayout
+from ..core.trees import Tree
 from .loading import LOADER, view_key
 from .solve import Solve
 from .views import EngineChecks, checks_for
@@ -82,24 +83,6 @@ def runs_compiled(checks: EngineChecks, engine: str) -> bool:
     return engine == "compiled" or checks.path == "kernel"
 
 
-def load(si: ob.SpaceInformation, layout: SpaceLayout, engine: str, wait: bool) -> None:
-    """Start loading the compiled engine for ``si``'s checks in the background, or (``wait``) load
-    it now, where ``engine`` would plan on it (:func:`runs_compiled`).
-
-    Planners call this from ``setup()``: ``SimpleSetup.solve`` sets up before the solve's
-    time limit starts, so a wait here (``engine=compiled``) does not eat into the solve.
-    """
-    checks = checks_for(si, layout)
-    if not runs_compiled(checks, engine):
-        return
-    key = view_key((checks.view, layout))
-    warm = partial(_warm, checks.view, layout)
-    if wait:
-        LOADER.wait(key, warm, _describe(checks))
-    else:
-        LOADER.start(key, warm)
-
-
 @contextlib.contextmanager
 def _compile_lock() -> Iterator[None]:
     """An exclusive lock shared by the processes of the machine (where the system has ``flock``)."""
@@ -116,33 +99,89 @@ def _compile_lock() -> Iterator[None]:
             fcntl.flock(lock, fcntl.LOCK_UN)
 
 
-def prepared(solve: Solve, layout: SpaceLayout, room: int, engine: str, name: str) -> CompiledRun | None:
-    """The compiled engine's run of ``solve`` where ``engine`` plans on it (:func:`runs_compiled`)
-    and it is ready (``engine="compiled"``: made ready now), else ``None``."""
-    checks = checks_for(solve.si, layout)
-    if not runs_compiled(checks, engine):
-        return None
-    key = view_key((checks.view, layout))
-    ready = LOADER.ready(key)
-    if engine == "compiled" and not ready:
-        LOADER.wait(key, partial(_warm, checks.view, layout), _describe(checks))
-    elif not ready:
-        failure = LOADER.failure(key)
-        if failure is None:
-            if LOADER.start(key, partial(_warm, checks.view, layout)):
-                ou.OMPL_INFORM(f"{name}: the compiled engine is loading in the background; solving on Python meanwhile")
+class CompiledEngine:
+    """A planner's compiled engine, kept from its setup through its solves.
+
+    Its solves reuse the check view of the space information's checkers (with the engine's key
+    for it) and the arrays the loop works in; both are made again only when what they came
+    from changes (another checker, validator or layout; other trees). Making them anew each
+    solve would cost about as much as a short solve plans.
+    """
+
+    def __init__(self) -> None:
+        self._checks: EngineChecks | None = None
+        self._key: Any = None
+        self._arrays: Any = None  # the driver's SolveArrays (made at the first compiled solve)
+
+    def _current_checks(self, si: ob.SpaceInformation, layout: SpaceLayout) -> EngineChecks:
+        checks = checks_for(si, layout, self._checks)
+        if checks is not self._checks:
+            self._checks, self._key = checks, view_key((checks.view, layout))
+        return checks
+
+    def load(self, si: ob.SpaceInformation, layout: SpaceLayout, engine: str, wait: bool) -> None:
+        """Start loading the compiled engine for ``si``'s checks in the background, or (``wait``)
+        load it now, where ``engine`` would plan on it (:func:`runs_compiled`).
+
+        Planners call this from ``setup()``: ``SimpleSetup.solve`` sets up before the solve's
+        time limit starts, so a wait here (``engine=compiled``) does not eat into the solve.
+        """
+        checks = self._current_checks(si, layout)
+        if not runs_compiled(checks, engine):
+            return
+        warm = partial(_warm, checks.view, layout)
+        if wait:
+            LOADER.wait(self._key, warm, _describe(checks))
         else:
-            ou.OMPL_WARN(f"{name}: the compiled engine failed to compile ({failure}); solving on Python")
-        return None
-    return partial(_run, solve, checks, layout, key, room)
+            LOADER.start(self._key, warm)
 
+    def prepare(self, layout: SpaceLayout, start_tree: Tree, goal_tree: Tree) -> None:
+        """Make the arrays of solves on ``start_tree`` and ``goal_tree`` now, where the engine is
+        loaded (planners call this as they make their trees, at setup and clear, which a solve's
+        time does not count)."""
+        if self._key is None or not LOADER.ready(self._key):
+            return
+        from .driver import SolveArrays
 
-def _run(
-    solve: Solve, checks: EngineChecks, layout: SpaceLayout, key: Any, room: int, ptc: ob.PlannerTerminationCondition
-) -> tuple[Any, str]:
-    from .driver import run
+        if self._arrays is None or self._arrays.layout is not layout:
+            self._arrays = SolveArrays(layout)
+        self._arrays.hold(start_tree, goal_tree)
 
-    return run(solve, ptc, checks, layout, key, room), checks.path
+    def run_of(self, solve: Solve, layout: SpaceLayout, room: int, engine: str, name: str) -> CompiledRun | None:
+        """The compiled engine's run of ``solve`` where ``engine`` plans on it (:func:`runs_compiled`)
+        and it is ready (``engine="compiled"``: made ready now), else ``None``."""
+        checks = self._current_checks(solve.si, layout)
+        if not runs_compiled(checks, engine):
+            return None
+        key = self._key
+        if not LOADER.ready(key):
+            if engine == "compiled":
+                LOADER.wait(key, partial(_warm, checks.view, layout), _describe(checks))
+            else:
+                failure = LOADER.failure(key)
+                if failure is not None:
+                    ou.OMPL_WARN(f"{name}: the compiled engine failed to compile ({failure}); solving on Python")
+                elif LOADER.start(key, partial(_warm, checks.view, layout)):
+                    ou.OMPL_INFORM(
+                        f"{name}: the compiled engine is loading in the background; solving on Python meanwhile"
+                    )
+                return None
+        return partial(self._run, solve, checks, layout, key, room)
+
+    def _run(
+        self,
+        solve: Solve,
+        checks: EngineChecks,
+        layout: SpaceLayout,
+        key: Any,
+        room: int,
+        ptc: ob.PlannerTerminationCondition,
+    ) -> tuple[Any, str]:
+        from .driver import SolveArrays, run
+
+        if self._arrays is None or self._arrays.layout is not layout:
+            self._arrays = SolveArrays(layout)
+        return run(solve, ptc, checks, key, room, self._arrays), checks.path
 
 
 def _describe(checks: EngineChecks) -> str:

@@ -28,7 +28,7 @@ from ..core.trees import ArrayTree
 from ..policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause
 from . import loop
 from .events import Grow, GrowStep, TreeChoiceEvent
-from .index import grown, new_index
+from .index import KDIndex, grown, new_index
 from .loop import Real, Record, Slot, Stop
 from .solve import Solve
 from .uniforms import bit_generator_address
@@ -61,15 +61,19 @@ def settings_of(solve: Solve) -> loop.Settings:
     )
 
 
-class _Arrays:
-    """The arrays of one compiled solve, grown when the loop asks for room."""
+class SolveArrays:
+    """The arrays the compiled loop works in, made once for a planner's layout and reused by its
+    solves (a short solve would spend more time allocating them than planning).
 
-    def __init__(self, solve: Solve, layout: SpaceLayout, room: int, record: bool) -> None:
-        self.solve = solve
-        self.room = room
+    :meth:`start` readies them for a solve: the loop's state zeroed and room made in the
+    planner's trees. A tree's nearest-neighbour index and cost array stay with it while the
+    planner keeps the tree (its nodes never change; later solves only add to it), and the
+    loop's settings while the planner's are unchanged (:meth:`settings_for`).
+    """
+
+    def __init__(self, layout: SpaceLayout) -> None:
+        self.layout = layout
         dim = layout.dim
-        self.costs = [np.empty(0), np.empty(0)]
-        self.indexes = [new_index(layout, 0), new_index(layout, 0)]
         self.loop = loop.Loop(
             sizes=np.zeros(2, dtype=np.int64),
             ints=np.zeros(Slot.COUNT, dtype=np.int64),
@@ -78,23 +82,62 @@ class _Arrays:
             uniforms=np.empty((SAMPLE_BLOCK, layout.total_draws)),
             step=np.empty(dim),
             target=np.empty(dim),
-            record=np.empty((4 * room + 64 if record else 0, Record.COUNT), dtype=np.int64),
-            record_target=np.empty((4 * room + 64 if record else 0, dim)),
+            record=np.empty((0, Record.COUNT), dtype=np.int64),
+            record_target=np.empty((0, dim)),
         )
-        self.trees = self.make_room()
+        self._planner_trees: tuple[ArrayTree, ...] = ()  # the trees the indexes and costs are for
+        self.indexes: list[KDIndex] = []
+        self.costs: list[np.ndarray] = []
+        self.failures: list[Any] = []
+        self.room = 0
+        self._settings: tuple[tuple[Any, ...], loop.Settings] | None = None  # the last solve's, and their source
 
-    def tree_list(self) -> list[ArrayTree]:
-        return [self.solve.start_tree, self.solve.goal_tree]  # type: ignore[list-item]
+    def settings_for(self, solve: Solve) -> loop.Settings:
+        """The compiled loop's settings for ``solve``: the last solve's when the planner's settings,
+        the points and recording are unchanged."""
+        source = (solve.points, solve.record is not None, *vars(solve.settings).values())
+        if self._settings is None or self._settings[0] != source:
+            self._settings = (source, settings_of(solve))
+        return self._settings[1]
 
-    def make_room(self) -> tuple[loop.Tree, loop.Tree]:
-        """Room for one more iteration in both trees (and the record); the trees' arrays as the loop takes them."""
+    def hold(self, start_tree: ArrayTree, goal_tree: ArrayTree) -> None:
+        """Keep the index and cost arrays of the planner's trees ``start_tree``, ``goal_tree`` (new
+        ones, sized for the trees' capacity, unless they are the trees held already)."""
+        held = self._planner_trees
+        if len(held) == 2 and held[0] is start_tree and held[1] is goal_tree:
+            return
+        self._planner_trees = (start_tree, goal_tree)
+        capacities = [len(tree.storage().parents) for tree in self._planner_trees]
+        self.indexes = [new_index(self.layout, capacity) for capacity in capacities]
+        self.costs = [np.empty(capacity) for capacity in capacities]
+
+    def start(self, solve: Solve, room: int, record: bool) -> None:
+        """Ready the arrays for ``solve`` (``room``: the nodes an iteration may add; ``record``:
+        whether the loop records what it does)."""
+        start_tree, goal_tree = solve.start_tree, solve.goal_tree
+        assert isinstance(start_tree, ArrayTree) and isinstance(goal_tree, ArrayTree)
+        self.hold(start_tree, goal_tree)
+        self.failures = [solve.failures[start_tree], solve.failures[goal_tree]]
+        self.room = room
+        self.loop.ints[:] = 0
+        self.loop.reals[:] = 0.0
+        rows = 4 * room + 64 if record else 0
+        if len(self.loop.record) < rows or (rows == 0 and len(self.loop.record)):
+            self.loop = self.loop._replace(
+                record=np.empty((rows, Record.COUNT), dtype=np.int64), record_target=np.empty((rows, self.layout.dim))
+            )
+        self.make_room()
+
+    def make_room(self) -> None:
+        """Room for one more iteration in both trees (and the record); :attr:`trees`: the trees'
+        arrays as the loop takes them."""
         trees = []
-        for t, tree in enumerate(self.tree_list()):
+        for t, tree in enumerate(self._planner_trees):
             needed = len(tree) + self.room
             tree.reserve(needed)
             storage = tree.storage()
             capacity = len(storage.parents)
-            failures = self.solve.failures[tree]
+            failures = self.failures[t]
             failures.reserve(capacity)
             if len(self.costs[t]) < capacity:
                 self.costs[t] = _grown(self.costs[t], capacity)
@@ -109,11 +152,11 @@ class _Arrays:
             self.loop = self.loop._replace(
                 record=_grown(record, rows), record_target=_grown(self.loop.record_target, rows)
             )
-        return trees[0], trees[1]
+        self.trees = trees[0], trees[1]
 
     def adopt(self) -> None:
         """The planner's trees take the nodes the loop added."""
-        for t, tree in enumerate(self.tree_list()):
+        for t, tree in enumerate(self._planner_trees):
             tree.adopt(int(self.loop.sizes[t]))
 
 
@@ -165,13 +208,19 @@ def interrupts_between_slices() -> Iterator[Callable[[], None]]:
 
 
 def run(
-    solve: Solve, ptc: ob.PlannerTerminationCondition, checks: EngineChecks, layout: SpaceLayout, key: Any, room: int
+    solve: Solve,
+    ptc: ob.PlannerTerminationCondition,
+    checks: EngineChecks,
+    key: Any,
+    room: int,
+    arrays: SolveArrays,
 ) -> ob.PlannerStatus.PlannerStatusType:
-    """The loop of ``solve`` on the compiled engine, as :func:`ompl_balance.engine.python_loop.run`
-    (``key``: the :func:`~ompl_balance.engine.loading.view_key` of ``checks.view`` and ``layout``)."""
-    settings = settings_of(solve)
-    arrays = _Arrays(solve, layout, room, settings.record)
-    ints, reals = arrays.loop.ints, arrays.loop.reals
+    """The loop of ``solve`` on the compiled engine, as :func:`ompl_balance.engine.python_loop.run`,
+    in ``arrays`` (``key``: the :func:`~ompl_balance.engine.loading.view_key` of ``checks.view``
+    and the layout; ``room``: the nodes an iteration may add)."""
+    settings = arrays.settings_for(solve)
+    arrays.start(solve, room, settings.record)
+    layout, ints, reals = arrays.layout, arrays.loop.ints, arrays.loop.reals
     state = solve.tree_choice.state
     ints[Slot.GREW_START], ints[Slot.STEPS], ints[Slot.COLLIDED] = state.grew_start, state.steps, state.collided
     ints[Slot.NEXT_SAMPLE] = SAMPLE_BLOCK  # a fresh block at the first sample, as the Python engine's
@@ -186,7 +235,7 @@ def run(
         """The goal state the next iteration asks for, fed; ``False`` when there is none."""
         if not solve.feed_goal(ptc):
             return False
-        arrays.trees = arrays.make_room()
+        arrays.make_room()
         ints[Slot.GOAL_FED] = 1
         return True
 
@@ -204,7 +253,7 @@ def run(
                 raise_interrupt()
                 solve.progress.iterations = int(ints[Slot.ITERATIONS])
                 if stop == Stop.NEED_ROOM:
-                    arrays.trees = arrays.make_room()
+                    arrays.make_room()
                 elif stop == Stop.NEED_GOAL:
                     if not feed_goal():
                         status = ob.PlannerStatus.INVALID_GOAL
@@ -214,13 +263,13 @@ def run(
                     break
         finally:
             arrays.adopt()
-            _report(solve, arrays, settings, int(checks.view.counts[Count.EXITS]) - exits_before)
+            _report(solve, arrays.loop, int(checks.view.counts[Count.EXITS]) - exits_before)
     return status
 
 
-def _report(solve: Solve, arrays: _Arrays, settings: loop.Settings, exits: int) -> None:
+def _report(solve: Solve, arrays: loop.Loop, exits: int) -> None:
     """Hand what the compiled loop did to the planner's side: swap state, counts, gap, record."""
-    ints, reals = arrays.loop.ints, arrays.loop.reals
+    ints, reals = arrays.ints, arrays.reals
     state = solve.tree_choice.state
     state.grew_start, state.steps, state.collided = (
         bool(ints[Slot.GREW_START]),
@@ -235,7 +284,7 @@ def _report(solve: Solve, arrays: _Arrays, settings: loop.Settings, exits: int) 
     solve.progress.iterations = counts.iterations
     solve.tree_gap = float(reals[Real.TREE_GAP])
     if solve.record is not None:
-        _fill_record(solve, arrays.loop)
+        _fill_record(solve, arrays)
 
 
 def _fill_record(solve: Solve, arrays: loop.Loop) -> None:

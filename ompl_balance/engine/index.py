@@ -18,10 +18,16 @@ point whose distances are chords of the rotation distance:
 So every distance is at least ``w_p`` times the distance of the positions plus ``w_r`` times
 that of the rotation points (less :data:`CHORD_SLACK`, for OMPL's tolerance that calls nearly
 equal quaternions 0 apart and for rounding); the other leaves add non-negative terms.
-:class:`KDIndex` keeps the nodes' index coordinates in a k-d tree, rebuilt as the tree grows,
-plus the nodes added since the last build, which a query scans. A query descends towards its
-own coordinates first and skips a subtree whose bound, from how far the query lies outside it
-along each axis, is above the best distance found. The answer is the linear scan's, node for
+
+:class:`KDIndex` keeps the nodes' index coordinates in a few static k-d trees (Bentley and
+Saxe's logarithmic method): the built nodes ``0 .. BUILT - 1`` fall into consecutive blocks
+whose sizes are :data:`BLOCK` times the powers of two in ``BUILT / BLOCK``, largest first, each
+its own k-d tree; the fewer than :data:`BLOCK` nodes added since are scanned. When
+:data:`BLOCK` more nodes arrive, the blocks that the binary count changes are built again as
+one (as a binary counter carries), so each node is rebuilt at most ``log2(n / BLOCK)`` times
+and a query's cost grows with the logarithm of the tree, not with its size. A query
+descends each block towards its own coordinates first and skips a subtree whose bound, from
+how far the query lies outside it along each axis, is above the best distance found. The answer is the linear scan's, node for
 node: the least distance, and the lowest index among equal ones (subtrees are skipped only
 when strictly farther). A quaternion not of unit length (to :data:`UNIT_TOLERANCE`) leaves
 the rotation out of the bounds of that build or query.
@@ -41,10 +47,11 @@ from ..core.layout import Leaf, SpaceLayout
 
 #: Trees with fewer nodes are scanned (the index does not pay).
 INDEX_FROM = 256
-#: The nodes added since the last build that a query scans before the index is built again:
-#: at most this fraction of the built nodes (and at least INDEX_FROM).
-UNBUILT_FRACTION = 1 / 32
-#: Depth of a query's stack: enough for a k-d tree of 2**62 nodes.
+#: Nodes per unit of the logarithmic method: the built blocks are this many times a power of
+#: two, and a query scans fewer than this many nodes added since the last build.
+BLOCK = 128
+#: Depth of a query's stack: the blocks' subtrees pending (one per block, at most 62) and one
+#: path down a k-d tree of up to 2**62 nodes.
 STACK = 128
 #: Taken off the rotation's chord bound: OMPL's distance of quaternions ``|q1 . q2| > 1 - 1e-9``
 #: is 0 where their chord is up to 4.5e-5, and rounding.
@@ -62,16 +69,17 @@ class Setting(enum.IntEnum):
     ROTATION = 2  # the rotation leaf's first coordinate (-1: none)
     ROTATION_KIND = 3  # its Leaf kind (SO2 or SO3)
     AXES = 4  # index coordinates in all (0: no position or rotation leaf: the tree is scanned)
-    BUILT = 5  # nodes 0 .. BUILT - 1 are in the k-d tree
+    BUILT = 5  # nodes 0 .. BUILT - 1 are in the blocks' k-d trees (a multiple of BLOCK)
     UNIT_ROTATIONS = 6  # 1 when the built nodes' rotations count in the bounds
     COUNT = 7
 
 
 class KDIndex(NamedTuple):
-    """One tree's k-d tree over the nodes' index coordinates.
+    """One tree's k-d trees (one per block) over the nodes' index coordinates.
 
-    ``order`` (capacity,): node indices in k-d layout (the subtree of ``order[lo:hi]`` has its
-    splitting node at ``order[(lo + hi) // 2]``, smaller coordinates before it, larger after);
+    ``order`` (capacity,): node indices in k-d layout, each block in its own rows (the subtree
+    of ``order[lo:hi]`` has its splitting node at ``order[(lo + hi) // 2]``, smaller coordinates
+    before it, larger after);
     ``points`` (capacity, axes): their index coordinates in the same order (a query walks them,
     not the tree's scattered states; ``axes``: up to 3 of a position and 4 of a rotation,
     ``ints[Setting.AXES]``); ``coordinates`` (capacity, axes): each node's, by node
@@ -117,19 +125,17 @@ def new_index(layout: SpaceLayout, capacity: int) -> KDIndex:
         weight[1] = layout.weight[rotation]
     rotation_axes = 0 if rotation == NONE else (2 if layout.kind[rotation] == Leaf.SO2 else 4)
     axes = ints[Setting.AXES] = ints[Setting.POSITION_AXES] + rotation_axes
-    return grown(
-        KDIndex(
-            np.zeros(0, dtype=np.int64),
-            np.zeros((0, axes)),
-            np.zeros((0, axes)),
-            np.zeros(0, dtype=np.int64),
-            np.zeros((STACK, 2), dtype=np.int64),
-            np.zeros((STACK, axes)),
-            np.zeros(axes),
-            ints,
-            weight,
-        ),
-        capacity,
+    rows = capacity if axes else 0  # (without axes the tree is scanned: no node arrays)
+    return KDIndex(
+        np.zeros(rows, dtype=np.int64),
+        np.zeros((rows, axes)),
+        np.zeros((rows, axes)),
+        np.zeros(rows, dtype=np.int64),
+        np.zeros((STACK, 2), dtype=np.int64),
+        np.zeros((STACK, axes)),
+        np.zeros(axes),
+        ints,
+        weight,
     )
 
 
@@ -264,46 +270,66 @@ def _select(order: np.ndarray, values: np.ndarray, column: int, lo: int, hi: int
 
 
 @njit(cache=True)
-def _build(index: KDIndex, states: np.ndarray, size: int) -> None:  # pragma: no cover (compiled)
-    """The k-d tree of nodes ``0 .. size - 1``: each subtree split at its median along its
-    widest axis (spreads weighted as their part of the distance). A node's state does not
-    change once added, so its index coordinates are worked out at the first build only."""
+def _build(index: KDIndex, lo: int, hi: int) -> None:  # pragma: no cover (compiled)
+    """The k-d tree of block ``lo .. hi - 1`` (nodes with their index coordinates worked out),
+    in ``order[lo:hi]``, ``points[lo:hi]``, ``axis[lo:hi]``: each subtree split at its median along
+    its widest axis (spreads weighted as their part of the distance)."""
     order, coordinates, ints = index.order, index.coordinates, index.ints
     axes, position_axes = ints[Setting.AXES], ints[Setting.POSITION_AXES]
-    unit = ints[Setting.BUILT] == 0 or ints[Setting.UNIT_ROTATIONS] == 1
-    for node in range(ints[Setting.BUILT], size):
-        if not _index_coordinates(index, states[node], coordinates[node]):
-            unit = False
-    ints[Setting.UNIT_ROTATIONS] = 1 if unit else 0
-    for node in range(size):
+    for node in range(lo, hi):
         order[node] = node
     stack = index.stack
-    stack[0, 0], stack[0, 1] = 0, size
+    stack[0, 0], stack[0, 1] = lo, hi
     depth = 1
     while depth > 0:
         depth -= 1
-        lo, hi = stack[depth, 0], stack[depth, 1]
-        if hi - lo < 2:
+        first, last = stack[depth, 0], stack[depth, 1]
+        if last - first < 2:
             continue
         widest, spread = 0, -1.0
         for axis in range(axes):
             smallest, largest = np.inf, -np.inf
-            for i in range(lo, hi):
+            for i in range(first, last):
                 value = coordinates[order[i], axis]
                 smallest, largest = min(smallest, value), max(largest, value)
             weighted = (largest - smallest) * index.weight[0 if axis < position_axes else 1]
             if weighted > spread:
                 widest, spread = axis, weighted
-        middle = (lo + hi) // 2
-        _select(order, coordinates, widest, lo, hi, middle)
+        middle = (first + last) // 2
+        _select(order, coordinates, widest, first, last, middle)
         index.axis[middle] = widest
-        stack[depth, 0], stack[depth, 1] = lo, middle
-        stack[depth + 1, 0], stack[depth + 1, 1] = middle + 1, hi
+        stack[depth, 0], stack[depth, 1] = first, middle
+        stack[depth + 1, 0], stack[depth + 1, 1] = middle + 1, last
         depth += 2
-    for i in range(size):
+    for i in range(lo, hi):
         for axis in range(axes):
             index.points[i, axis] = coordinates[order[i], axis]
-    ints[Setting.BUILT] = size
+
+
+@njit(cache=True)
+def _add_blocks(index: KDIndex, states: np.ndarray, size: int) -> None:  # pragma: no cover (compiled)
+    """Build the nodes up to the last whole :data:`BLOCK` of ``size`` into the index: their index
+    coordinates worked out (once: a node's state never changes), then the blocks that the count
+    of built units changes built again, as a binary counter carries."""
+    ints = index.ints
+    built = ints[Setting.BUILT]
+    units, new_units = built // BLOCK, size // BLOCK
+    unit = built == 0 or ints[Setting.UNIT_ROTATIONS] == 1
+    for node in range(built, new_units * BLOCK):
+        if not _index_coordinates(index, states[node], index.coordinates[node]):
+            unit = False
+    ints[Setting.UNIT_ROTATIONS] = 1 if unit else 0
+    # The blocks of the bits above the highest that changed stay; those below it are new.
+    changed = units ^ new_units
+    high = 0
+    while changed >> (high + 1):
+        high += 1
+    lo = ((new_units >> (high + 1)) << (high + 1)) * BLOCK
+    for bit in range(high, -1, -1):
+        if new_units >> bit & 1:
+            _build(index, lo, lo + (BLOCK << bit))
+            lo += BLOCK << bit
+    ints[Setting.BUILT] = new_units * BLOCK
 
 
 @njit(cache=True)
@@ -311,12 +337,12 @@ def indexed_nearest(
     index: KDIndex, layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
     """The node of ``states[:size]`` nearest ``query`` and its distance, as the linear scan
-    (:func:`~ompl_balance.core.compiled_spaces.nearest`) answers; through the k-d tree when it applies."""
+    (:func:`~ompl_balance.core.compiled_spaces.nearest`) answers; through the k-d trees when they apply."""
     ints = index.ints
     if ints[Setting.AXES] == 0 or size < INDEX_FROM:
         return nearest(layout, states, size, query)
-    if size - ints[Setting.BUILT] > max(INDEX_FROM, int(ints[Setting.BUILT] * UNBUILT_FRACTION)):
-        _build(index, states, size)
+    if size - ints[Setting.BUILT] >= BLOCK:
+        _add_blocks(index, states, size)
     # (``euclidean`` a constant in each search: numba's code testing it node by node costs
     # several times more)
     if is_euclidean(layout):
@@ -330,7 +356,7 @@ def _search(
     index: KDIndex, layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray, euclidean: bool
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
     """The nearest node of ``states[:size]`` and its key (:func:`_key`): the nodes added since
-    the build scanned, then the k-d tree's descended."""
+    the last build scanned, then each block's k-d tree descended (the largest first)."""
     ints = index.ints
     axes, built = ints[Setting.AXES], ints[Setting.BUILT]
     weight, position, position_axes = index.weight, ints[Setting.POSITION], ints[Setting.POSITION_AXES]
@@ -338,10 +364,16 @@ def _search(
     at = index.query
     rotations = _index_coordinates(index, query, at) and ints[Setting.UNIT_ROTATIONS] == 1
     order, points, stack, gaps = index.order, index.points, index.stack, index.gaps
-    stack[0, 0], stack[0, 1] = 0, built
-    for k in range(axes):
-        gaps[0, k] = 0.0
-    depth = 1
+    # the blocks pushed smallest first, so the largest (the likeliest to hold the nearest) is popped first
+    depth, units, hi, bit = 0, built // BLOCK, built, 0
+    while units >> bit:
+        if units >> bit & 1:
+            stack[depth, 0], stack[depth, 1] = hi - (BLOCK << bit), hi
+            hi -= BLOCK << bit
+            for k in range(axes):
+                gaps[depth, k] = 0.0
+            depth += 1
+        bit += 1
     while depth > 0:
         depth -= 1
         lo, hi = stack[depth, 0], stack[depth, 1]

@@ -47,6 +47,7 @@ def view_key(value: Any) -> Any:
 
 
 _KEYS: dict[int, tuple[Any, Any]] = {}  # id -> (the value, its key), the value kept so its id is not reused
+_INTERNED: dict[Any, Any] = {}  # each distinct named-tuple key, once (as many as kinds of view in use)
 
 
 class _Key:
@@ -68,7 +69,9 @@ class _Key:
 
 def _view_key(value: Any) -> Any:
     if isinstance(value, tuple) and hasattr(value, "_fields"):
-        return _Key((type(value), tuple(view_key(field) for field in value)))
+        key = _Key((type(value), tuple(view_key(field) for field in value)))
+        # one object per distinct key: later lookups of it compare by identity, not item by item
+        return _INTERNED.setdefault(key, key)
     if isinstance(value, tuple):
         return tuple(view_key(item) for item in value)
     if isinstance(value, np.ndarray):

@@ -82,31 +82,44 @@ def call_check_motion(handle: int, a: np.ndarray, b: np.ndarray) -> bool:
 
 
 class EngineChecks:
-    """The check view of one solve and what it holds on to while the solve runs.
+    """The check view of a solve and what it holds on to while the solve runs.
 
     ``path`` says how the checks are made: ``"kernel"`` (compiled kernels, leaving to Python
     only for what they cannot decide) or ``"python"`` (``si.isValid``/``si.checkMotion``).
+    ``source``: the objects it was made from (validity checker, motion validator, their compiled
+    view, the layout), by identity.
     """
 
-    def __init__(self, view: Any, path: str, keep: Any = None) -> None:
+    def __init__(self, view: Any, path: str, source: tuple[Any, ...], keep: Any = None) -> None:
         self.view = view
         self.path = path
+        self.source = source
         self.keep = keep  # the object behind the view's exit handle (held weakly by the registry)
 
+    def made_from(self, source: tuple[Any, ...]) -> bool:
+        """Whether these checks were made from the very objects ``source``."""
+        return len(source) == len(self.source) and all(a is b for a, b in zip(source, self.source))
 
-def checks_for(si: ob.SpaceInformation, layout: SpaceLayout) -> EngineChecks:
-    """The check view the compiled engine uses for ``si``'s validity checker and motion validator."""
+
+def checks_for(si: ob.SpaceInformation, layout: SpaceLayout, previous: EngineChecks | None = None) -> EngineChecks:
+    """The check view the compiled engine uses for ``si``'s validity checker and motion validator:
+    ``previous`` (the checks of an earlier solve) when it was made from the same checker,
+    validator, compiled view and layout, else new checks."""
     checker, validator = si.getStateValidityChecker(), si.getMotionValidator()
     motions = getattr(validator, "compiled_view", lambda: None)()
+    states = None if motions is not None else getattr(checker, "compiled_view", lambda: None)()
+    source = (checker, validator, motions if motions is not None else states, layout)
+    if previous is not None and previous.made_from(source):
+        return previous
     if motions is not None:
-        return EngineChecks(motions, "kernel")
-    states = getattr(checker, "compiled_view", lambda: None)()
+        return EngineChecks(motions, "kernel", source)
     # OMPL's own DiscreteMotionValidator, or one that checks the same states
     discrete = type(validator) is ob.MotionValidator or getattr(validator, "checks_as_discrete", False)
     if states is not None and discrete:
         # room for OMPL's bisection queue of a motion across the whole space
         longest = max(int(f) * math.ceil(si.getMaximumExtent() / g) for f, g in zip(layout.factor, layout.segment))
         queue = np.empty((2 * longest + 4, 2), dtype=np.int64)
-        return EngineChecks(DiscreteMotions(states, layout, np.empty(layout.dim), queue, states.counts), "kernel")
+        view = DiscreteMotions(states, layout, np.empty(layout.dim), queue, states.counts)
+        return EngineChecks(view, "kernel", source)
     space_checks = SpaceChecks(si)
-    return EngineChecks(PythonChecks(exit_handle(space_checks), new_counts()), "python", space_checks)
+    return EngineChecks(PythonChecks(exit_handle(space_checks), new_counts()), "python", source, space_checks)
