@@ -23,11 +23,13 @@ the engines' speed alone.
     Where a compiled solve's time goes on the Panda problems: the certified edges and state
     checks in compiled code (the edges and states of the same runs, replayed through the
     kernels), the calls out to Python (FCL on pairs the kernels cannot decide, timed), the rest
-    of the compiled slices (the loop: nearest nodes, sampling, trees), and the Python around the
-    slices (the planner's solve before and after the loop: start and goal states through OMPL,
-    the arrays, the path, the statistics), and ``SimpleSetup.solve`` around the planner (with a
+    of the compiled slices (the loop: nearest nodes, sampling, trees), OMPL's checks of the start
+    and goal states (through the checker's Python entry), the planner's other Python around the
+    slices (its solve before and after the loop: start and goal states through OMPL, the
+    policies, the path, the statistics), and ``SimpleSetup.solve`` around the planner (with a
     time limit of a second or more, OMPL evaluates it in a thread of its own, which the solve
-    waits for at its end).
+    waits for at its end). The script's own objects are set aside first (``gc.freeze``), so
+    that Python's collector walking them does not count as the planner's time.
 ``scaling``
     The cost of an iteration as the trees grow to tens of thousands of nodes, in R^2 and SE(3)
     (a box world and a rigid body, each cut in two by a wall so that both trees grow freely
@@ -41,6 +43,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import gc
 import itertools
 import platform
 import time
@@ -212,25 +215,39 @@ def recorded_checks() -> Iterator[tuple[list[tuple[np.ndarray, np.ndarray]], lis
 
 @contextlib.contextmanager
 def timed_exits() -> Iterator[list[float]]:
-    """Seconds spent in the compiled kernels' calls out to Python (FCL) while inside, in ``[0]``."""
-    spent = [0.0]
-    decide, hard = CollisionChecker.decide, certified.MotionCertifier.hard_segments_free
+    """Seconds spent while inside in the compiled kernels' calls out to Python (FCL), in ``[0]``,
+    and in the checker's Python entry for one state (``is_valid``: OMPL's checks of the start
+    and goal states; the compiled loop checks states in its kernels), in ``[1]``, whose own
+    calls out to Python count there only."""
+    spent = [0.0, 0.0]
+    inside_is_valid = [False]
+    decide, hard, is_valid = (
+        CollisionChecker.decide,
+        certified.MotionCertifier.hard_segments_free,
+        CollisionChecker.is_valid,
+    )
 
-    def timed(function):
+    def timed(function, slot):
         def wrapper(*arguments, **keywords):
+            if slot == 0 and inside_is_valid[0]:
+                return function(*arguments, **keywords)
+            inside_is_valid[0] = slot == 1
             began = time.perf_counter()
             try:
                 return function(*arguments, **keywords)
             finally:
-                spent[0] += time.perf_counter() - began
+                spent[slot] += time.perf_counter() - began
+                inside_is_valid[0] = False
 
         return wrapper
 
-    CollisionChecker.decide, certified.MotionCertifier.hard_segments_free = timed(decide), timed(hard)
+    CollisionChecker.decide, certified.MotionCertifier.hard_segments_free = timed(decide, 0), timed(hard, 0)
+    CollisionChecker.is_valid = timed(is_valid, 1)
     try:
         yield spent
     finally:
         CollisionChecker.decide, certified.MotionCertifier.hard_segments_free = decide, hard
+        CollisionChecker.is_valid = is_valid
 
 
 @contextlib.contextmanager
@@ -270,19 +287,20 @@ def seeded_solve(robot, problem: MBMProblem, engine: str, seed: int, time_limit:
 
 def profile_problem(
     robot, problem: MBMProblem, time_limit: float, replay: Callable
-) -> tuple[float, float, float, float, float, int]:
+) -> tuple[float, float, float, float, float, float, int]:
     """A compiled solve's time (``ss.solve``'s and the planner's own), its time in calls out to
-    Python, its edges' and states' time in the kernels, its time inside the compiled slices, and
-    its edges. The Python engine on the same seed makes the same trees, so its validator's calls
-    are the compiled engine's edges and states."""
+    Python, its edges' and states' time in the kernels, its time inside the compiled slices, its
+    time in OMPL's checks of the start and goal states, and its edges. The Python engine on the
+    same seed makes the same trees, so its validator's calls are the compiled engine's edges and
+    states."""
     seed = 1 + problem.id
     with recorded_checks() as (edges, states):
         seeded_solve(robot, problem, "python", seed, time_limit)
     with timed_exits() as spent, timed_slices() as sliced:
         solve_time, planner_time = seeded_solve(robot, problem, "compiled", seed, time_limit)
-    exit_time, slice_time = spent[0], sliced[0]
+    exit_time, endpoint_time, slice_time = spent[0], spent[1], sliced[0]
     if not edges:
-        return solve_time, planner_time, exit_time, 0.0, slice_time, 0
+        return solve_time, planner_time, exit_time, 0.0, slice_time, endpoint_time, 0
     certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))  # (the view's exits)
     view = certifier.compiled_view()
     starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
@@ -291,12 +309,18 @@ def profile_problem(
         began = time.perf_counter()
         replay(view, starts, ends, np.array(states).reshape(-1, robot.dof))
         kernel_time = time.perf_counter() - began - spent[0]
-    return solve_time, planner_time, exit_time, kernel_time, slice_time, len(edges)
+    return solve_time, planner_time, exit_time, kernel_time, slice_time, endpoint_time, len(edges)
 
 
 def profile(args) -> None:
     """Where the compiled engine's time goes (see the module docstring)."""
     from numba import njit
+
+    # The parts before this one leave the process a large heap; Python's collector walking it
+    # during the solves' calls out to Python doubled their time in a full run. Set aside what
+    # exists now so that the profile shows the planner's costs, not the script's.
+    gc.collect()
+    gc.freeze()
 
     from ompl_balance.collision.kernels import certified_motion_free, robot_state_free
 
@@ -313,24 +337,31 @@ def profile(args) -> None:
     print(f"\nWhere a compiled solve's time goes: first {args.problems} problems per scenario, certified motions\n")
     print(
         "| scenario | solve time (ms, total) | edges and states in compiled code | calls out to Python (FCL) "
-        "| the compiled loop (nearest nodes, samples, trees) | the planner's Python around the slices "
-        "(ms per solve) | SimpleSetup around the planner (ms per solve) | us / edge (kernel) |"
-        "\n|---|---|---|---|---|---|---|---|"
+        "| the compiled loop (nearest nodes, samples, trees) | OMPL's checks of the start and goal states "
+        "(ms per solve) | the planner's other Python around the slices (ms per solve) "
+        "| SimpleSetup around the planner (ms per solve) | us / edge (kernel) |"
+        "\n|---|---|---|---|---|---|---|---|---|"
     )
-    for scenario in SCENARIOS:
-        totals = np.zeros(6)
-        problems = load_mbm(scenario, robot.joint_names)[: args.problems]
-        for problem in problems:
-            totals += profile_problem(robot, problem, args.time_limit, replay)
-        solve_time, planner_time, exit_time, kernel_time, slice_time, edges = totals
-        loop_time = slice_time - exit_time - kernel_time
-        around, outside = planner_time - slice_time, solve_time - planner_time
-        shares = [f"{seconds / solve_time:.0%}" for seconds in (kernel_time, exit_time, loop_time)]
-        shares += [f"{seconds / solve_time:.0%} ({seconds / len(problems) * 1e3:.2f})" for seconds in (around, outside)]
-        print(
-            f"| {scenario} | {solve_time * 1e3:.0f} | {' | '.join(shares)} | {kernel_time / max(edges, 1) * 1e6:.0f} |",
-            flush=True,
-        )
+    try:
+        for scenario in SCENARIOS:
+            totals = np.zeros(7)
+            problems = load_mbm(scenario, robot.joint_names)[: args.problems]
+            for problem in problems:
+                totals += profile_problem(robot, problem, args.time_limit, replay)
+            solve_time, planner_time, exit_time, kernel_time, slice_time, endpoint_time, edges = totals
+            loop_time = slice_time - exit_time - kernel_time
+            around, outside = planner_time - slice_time - endpoint_time, solve_time - planner_time
+            shares = [f"{seconds / solve_time:.0%}" for seconds in (kernel_time, exit_time, loop_time)]
+            shares += [
+                f"{seconds / solve_time:.0%} ({seconds / len(problems) * 1e3:.2f})"
+                for seconds in (endpoint_time, around, outside)
+            ]
+            print(
+                f"| {scenario} | {solve_time * 1e3:.0f} | {' | '.join(shares)} | {kernel_time / max(edges, 1) * 1e6:.0f} |",
+                flush=True,
+            )
+    finally:
+        gc.unfreeze()
 
 
 def split_box_world() -> Callable[[], og.SimpleSetup]:
