@@ -49,7 +49,7 @@ from ..core.layout import Leaf, SpaceLayout
 INDEX_FROM = 256
 #: Nodes per unit of the logarithmic method: the built blocks are this many times a power of
 #: two, and a query scans fewer than this many nodes added since the last build.
-BLOCK = 128
+BLOCK = 64
 #: Depth of a query's stack: the blocks' subtrees pending (one per block, at most 62) and one
 #: path down a k-d tree of up to 2**62 nodes.
 STACK = 128
