@@ -1,6 +1,6 @@
 """The compiled engine against the Python engine and stock OMPL, measured in one run.
 
-Three parts (``--part``), each printing a table of medians and ratios measured in the same
+Five parts (``--part``), each printing a table of medians and ratios measured in the same
 run, planners interleaved run by run so that the machine's slow phases hit all of them. The
 two engines get the same seed in each run, so they make the same trees: their time ratio is
 the engines' speed alone.
@@ -28,15 +28,22 @@ the engines' speed alone.
     slices (its solve before and after the loop: start and goal states through OMPL, the
     policies, the path, the statistics), and ``SimpleSetup.solve`` around the planner (with a
     time limit of a second or more, OMPL evaluates it in a thread of its own, which the solve
-    waits for at its end). The script's own objects are set aside first (``gc.freeze``), so
-    that Python's collector walking them does not count as the planner's time.
+    waits for at its end).
 ``scaling``
     The cost of an iteration as the trees grow to tens of thousands of nodes, in R^2 and SE(3)
     (a box world and a rigid body, each cut in two by a wall so that both trees grow freely
     and never meet): solves of increasing length on one seed, each repeating the shorter ones,
     so the difference of two is the cost of the iterations between them.
 
-Run: ``python benchmarks/bench_engine.py [--part panda,2d,profile,scaling] [--problems 25] [--runs 1]``
+``index``
+    The nearest-node index alone: a tree of uniform SE(3) states in an 8 m cube grown to 20,000
+    nodes with one query at each size (the index's builds included), and a linear scan of the
+    same tree, per query.
+
+Each part starts with the objects the script made before it set aside (``gc.freeze``), so that
+Python's collector walking them is not charged to the planners of the part.
+
+Run: ``python benchmarks/bench_engine.py [--part panda,2d,profile,scaling,index] [--problems 25] [--runs 1]``
 """
 
 from __future__ import annotations
@@ -316,12 +323,6 @@ def profile(args) -> None:
     """Where the compiled engine's time goes (see the module docstring)."""
     from numba import njit
 
-    # The parts before this one leave the process a large heap; Python's collector walking it
-    # during the solves' calls out to Python doubled their time in a full run. Set aside what
-    # exists now so that the profile shows the planner's costs, not the script's.
-    gc.collect()
-    gc.freeze()
-
     from ompl_balance.collision.kernels import certified_motion_free, robot_state_free
 
     @njit
@@ -342,26 +343,23 @@ def profile(args) -> None:
         "| SimpleSetup around the planner (ms per solve) | us / edge (kernel) |"
         "\n|---|---|---|---|---|---|---|---|---|"
     )
-    try:
-        for scenario in SCENARIOS:
-            totals = np.zeros(7)
-            problems = load_mbm(scenario, robot.joint_names)[: args.problems]
-            for problem in problems:
-                totals += profile_problem(robot, problem, args.time_limit, replay)
-            solve_time, planner_time, exit_time, kernel_time, slice_time, endpoint_time, edges = totals
-            loop_time = slice_time - exit_time - kernel_time
-            around, outside = planner_time - slice_time - endpoint_time, solve_time - planner_time
-            shares = [f"{seconds / solve_time:.0%}" for seconds in (kernel_time, exit_time, loop_time)]
-            shares += [
-                f"{seconds / solve_time:.0%} ({seconds / len(problems) * 1e3:.2f})"
-                for seconds in (endpoint_time, around, outside)
-            ]
-            print(
-                f"| {scenario} | {solve_time * 1e3:.0f} | {' | '.join(shares)} | {kernel_time / max(edges, 1) * 1e6:.0f} |",
-                flush=True,
-            )
-    finally:
-        gc.unfreeze()
+    for scenario in SCENARIOS:
+        totals = np.zeros(7)
+        problems = load_mbm(scenario, robot.joint_names)[: args.problems]
+        for problem in problems:
+            totals += profile_problem(robot, problem, args.time_limit, replay)
+        solve_time, planner_time, exit_time, kernel_time, slice_time, endpoint_time, edges = totals
+        loop_time = slice_time - exit_time - kernel_time
+        around, outside = planner_time - slice_time - endpoint_time, solve_time - planner_time
+        shares = [f"{seconds / solve_time:.0%}" for seconds in (kernel_time, exit_time, loop_time)]
+        shares += [
+            f"{seconds / solve_time:.0%} ({seconds / len(problems) * 1e3:.2f})"
+            for seconds in (endpoint_time, around, outside)
+        ]
+        print(
+            f"| {scenario} | {solve_time * 1e3:.0f} | {' | '.join(shares)} | {kernel_time / max(edges, 1) * 1e6:.0f} |",
+            flush=True,
+        )
 
 
 def split_box_world() -> Callable[[], og.SimpleSetup]:
@@ -413,10 +411,79 @@ def scaling(args) -> None:
             print(f"| {label} | 100 to 20,000: most / least cost per iteration | | {max(costs) / min(costs):.2f} | |")
 
 
+#: Tree sizes at which the index part times its queries (each over the next INDEX_WINDOW sizes).
+INDEX_SIZES = (300, 1_000, 5_000, 20_000)
+INDEX_WINDOW = 512
+
+
+def index(args) -> None:
+    """Nearest-node queries as a tree of uniform SE(3) states grows (see the module docstring)."""
+    from numba import njit
+    from ompl import base as ob
+
+    from ompl_balance.core.compiled_spaces import nearest
+    from ompl_balance.core.layout import layout_for
+    from ompl_balance.engine.index import BLOCK, indexed_nearest, new_index
+
+    @njit
+    def grow_and_query(index, layout, states, first, last, queries):  # pragma: no cover (compiled)
+        """One query (of ``queries``, in turn) at each tree size ``first .. last - 1``."""
+        found = 0
+        for size in range(first, last):
+            found += indexed_nearest(index, layout, states, size, queries[size % queries.shape[0]])[0]
+        return found
+
+    @njit
+    def scan(layout, states, size, queries):  # pragma: no cover (compiled)
+        found = 0
+        for q in range(queries.shape[0]):
+            found += nearest(layout, states, size, queries[q])[0]
+        return found
+
+    space = ob.SE3StateSpace()
+    bounds = ob.RealVectorBounds(3)
+    bounds.setLow(-4.0)
+    bounds.setHigh(4.0)
+    space.setBounds(bounds)
+    ob.SpaceInformation(space).setup()
+    layout = layout_for(space)
+    rng = np.random.default_rng(1)
+
+    def uniform(count: int) -> np.ndarray:
+        quaternions = rng.normal(size=(count, 4))
+        return np.hstack(
+            [rng.uniform(-4.0, 4.0, (count, 3)), quaternions / np.linalg.norm(quaternions, axis=1)[:, None]]
+        )
+
+    total = INDEX_SIZES[-1] + INDEX_WINDOW
+    states, queries = uniform(total), uniform(4096)
+    tree_index = new_index(layout, total)
+    grow_and_query(tree_index, layout, states, 1, 2, queries)  # compiled before the timing
+    scan(layout, states, 1, queries[:1])
+    print(
+        f"\nNearest-node queries as a tree of uniform SE(3) states grows (an 8 m cube, all rotations; "
+        f"index blocks of {BLOCK} nodes a unit)\n\n| nodes | us / query, index (one query at each size, "
+        f"builds included) | us / query, linear scan |\n|---|---|---|"
+    )
+    grown = 1
+    for size in INDEX_SIZES:
+        grow_and_query(tree_index, layout, states, grown, size, queries)
+        began = time.perf_counter()
+        grow_and_query(tree_index, layout, states, size, size + INDEX_WINDOW, queries)
+        indexed = (time.perf_counter() - began) / INDEX_WINDOW
+        began = time.perf_counter()
+        scan(layout, states, size, queries[:200])
+        scanned = (time.perf_counter() - began) / 200
+        print(f"| {size:,} | {indexed * 1e6:.1f} | {scanned * 1e6:.1f} |", flush=True)
+        grown = size + INDEX_WINDOW
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "--part", default="panda,2d,profile,scaling", help="comma-separated parts: panda, 2d, profile, scaling"
+        "--part",
+        default="panda,2d,profile,scaling,index",
+        help="comma-separated parts: panda, 2d, profile, scaling, index",
     )
     parser.add_argument("--problems", type=int, default=25, help="Panda problems per scenario (default 25)")
     parser.add_argument("--runs", type=int, default=1, help="Panda runs per problem and planner (default 1)")
@@ -432,7 +499,13 @@ def main() -> None:
         f"{platform.python_version()}, ompl {metadata.version('ompl')}; compiled engine loaded before timing\n"
     )
     for part in args.part.split(","):
-        {"panda": panda, "2d": two_d, "profile": profile, "scaling": scaling}[part](args)
+        # Each part starts with the script's objects so far set aside: Python's collector walking
+        # them during a part's solves would charge the script's heap to the planners that make
+        # Python objects (the Python engine; calls out to Python), by up to 1.5-2x in a full run.
+        gc.collect()
+        gc.freeze()
+        {"panda": panda, "2d": two_d, "profile": profile, "scaling": scaling, "index": index}[part](args)
+    gc.unfreeze()
     print(f"\nwhole script: {time.perf_counter() - began:.0f} s; median of runs, ratios of medians")
 
 
