@@ -23,10 +23,10 @@ compared (``SwapLimitRRTConnect``, ...); ``docs/variants.md`` measures them.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
+from functools import partial
 from typing import Any, ClassVar
 
 import numpy as np
@@ -42,7 +42,7 @@ from .core.trees import NO_PARENT, Tree
 from .engine import python_loop
 from .engine.compiled import CompiledEngine, CompiledRun, room_per_iteration
 from .engine.events import LoopCounts, LoopRecord
-from .engine.solve import Solve
+from .engine.solve import LoopPolicies, Solve
 from .policies import (
     NEAREST_POLICIES,
     SAMPLE_POLICIES,
@@ -407,9 +407,8 @@ class BalancedRRTConnect(TreePlanner):
         self._distance_between_trees = solve.tree_gap
         if status == ob.PlannerStatus.EXACT_SOLUTION:
             assert solve.connection is not None
-            path = self._path_points(*solve.connection)
-            self._add_solution(points, path)
-            self.progress.best_cost = sum(points.distance(a, b) for a, b in itertools.pairwise(path))
+            path = self._add_solution(points, self._path_points(*solve.connection))
+            self.progress.best_cost = path.length()
         ou.OMPL_INFORM(
             f"{name}: Created {len(start_tree) + len(goal_tree)} states "
             f"({len(start_tree)} start + {len(goal_tree)} goal)"
@@ -417,7 +416,30 @@ class BalancedRRTConnect(TreePlanner):
         return result(status, solve, engine, checks)
 
     def _solve(self, points: Points, rng: np.random.Generator, inputs: ob.PlannerInputStates, goal: Any) -> Solve:
-        """This solve's policies around the planner's trees."""
+        """This solve around the planner's trees (its policies made only if the Python engine runs it)."""
+        assert self._start_tree is not None and self._goal_tree is not None
+        sampler_counts = SamplerCounts()
+        return Solve(
+            name=self.getName(),
+            si=self.getSpaceInformation(),
+            points=points,
+            settings=self.settings,
+            start_tree=self._start_tree,
+            goal_tree=self._goal_tree,
+            failures=self._failures,
+            swap_state=self._swap_state,
+            policies=partial(self._policies, points, rng, sampler_counts),
+            inputs=inputs,
+            goal=goal,
+            progress=self.progress,
+            rng=rng,
+            record=self.loop_record,
+            tree_gap=self._distance_between_trees,
+            sampler_counts=sampler_counts,
+        )
+
+    def _policies(self, points: Points, rng: np.random.Generator, sampler_counts: SamplerCounts) -> LoopPolicies:
+        """A solve's policies as objects, for the Python engine."""
         settings = self.settings
         assert self._start_tree is not None and self._goal_tree is not None
         tree_choice = TreeChoice(
@@ -435,7 +457,7 @@ class BalancedRRTConnect(TreePlanner):
             self._start_tree,
             self._goal_tree,
             rng.random,
-            SamplerCounts(),
+            sampler_counts,
             nearest,
             settings.goal_bias,
             settings.min_quality,
@@ -445,25 +467,7 @@ class BalancedRRTConnect(TreePlanner):
             si = self.getSpaceInformation()
             context.valid_sampler = self._valid_state_sampler()
             context.checker, context.scratch = si.getStateValidityChecker(), si.allocState()
-        return Solve(
-            name=self.getName(),
-            si=self.getSpaceInformation(),
-            points=points,
-            settings=settings,
-            start_tree=self._start_tree,
-            goal_tree=self._goal_tree,
-            failures=self._failures,
-            tree_choice=tree_choice,
-            nearest=nearest,
-            targets=target_choice(settings.sample_policy, context),
-            sample_context=context,
-            inputs=inputs,
-            goal=goal,
-            progress=self.progress,
-            rng=rng,
-            record=self.loop_record,
-            tree_gap=self._distance_between_trees,
-        )
+        return LoopPolicies(tree_choice, nearest, target_choice(settings.sample_policy, context))
 
     def _compiled_engine(self, solve: Solve) -> CompiledRun | None:
         """The compiled engine's run of ``solve``, or ``None`` when this solve runs on the Python engine."""

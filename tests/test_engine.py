@@ -22,6 +22,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect
+from ompl_balance.core.counting import CountingValidityChecker
 from ompl_balance.core.layout import layout_for
 from ompl_balance.planners import PRESETS
 from ompl_balance.worlds.boxes import BoxWorld2D, get_problem
@@ -421,10 +422,14 @@ def test_se3_trees_match_where_the_math_library_agrees_with_numpy():
 # -- termination, interruption, first use ---------------------------------------------------------
 
 
-def impossible_setup():
+def impossible_setup(kernels: bool = False):
+    """A wall across the space: no solve ends before its time. The world is a Python callable,
+    or (``kernels``) the package's checker, whose compiled view the engine calls."""
     walled = (*get_problem("narrow_gap").boxes[0][:3], 1.0)
     ss = get_problem("narrow_gap").setup()
-    ss.setStateValidityChecker(BoxWorld2D((walled,)))
+    si = ss.getSpaceInformation()
+    world = BoxWorld2D((walled,))
+    si.setStateValidityChecker(CountingValidityChecker(si, world) if kernels else world)
     return ss
 
 
@@ -483,16 +488,19 @@ def test_the_compiled_engine_polls_the_condition_every_few_milliseconds_and_stop
     assert np.median(gaps) < 0.005
 
 
-def test_ctrl_c_interrupts_a_compiled_solve():
+@pytest.mark.parametrize("checker", ["kernel", "python callable"])
+def test_ctrl_c_interrupts_a_compiled_solve(checker):
+    """Both with kernels that never call Python (SIGINT's own handler stays) and with every check
+    an exit to Python (SIGINT only sets a flag while a slice runs)."""
     script = textwrap.dedent(
-        """
+        f"""
         import sys
         from ompl import util as ou
         ou.setLogLevel(ou.LOG_WARN)
         sys.path.insert(0, "tests")
         from test_engine import impossible_setup
         from ompl_balance import BalancedRRTConnect
-        ss = impossible_setup()
+        ss = impossible_setup(kernels={checker == "kernel"})
         planner = BalancedRRTConnect(ss.getSpaceInformation())
         planner.setEngine("compiled")
         ss.setPlanner(planner)
@@ -525,17 +533,37 @@ def test_ctrl_c_in_a_compiled_slice_is_raised_between_slices_not_inside_it():
     from ompl_balance.engine.driver import interrupts_between_slices
 
     handler = signal.getsignal(signal.SIGINT)  # (Python's default, or "ignore" in a background job)
-    with pytest.raises(KeyboardInterrupt), interrupts_between_slices() as raise_interrupt:
+    with interrupts_between_slices(exits=False):
+        assert signal.getsignal(signal.SIGINT) is handler  # kernels without exits: left as it was
+    with pytest.raises(KeyboardInterrupt), interrupts_between_slices(exits=True) as raise_interrupt:
         raise_interrupt()  # nothing came yet
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.01)  # Python runs the handler here: no exception yet
         reached = True
         raise_interrupt()
     assert reached
-    with pytest.raises(KeyboardInterrupt), interrupts_between_slices():
+    with pytest.raises(KeyboardInterrupt), interrupts_between_slices(exits=True):
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.01)
     assert signal.getsignal(signal.SIGINT) is handler  # restored
+
+
+def test_check_views_say_whether_their_kernels_call_python():
+    """Only a solve whose kernels may call Python takes SIGINT over (see above): a box world's
+    kernels never do; a Python callable is called from its view's kernels."""
+    from ompl_balance.engine.views import checks_for
+
+    kernels, callable_world = impossible_setup(kernels=True), impossible_setup()
+    for ss in (kernels, callable_world):
+        ss.setPlanner(BalancedRRTConnect(ss.getSpaceInformation()))  # (its setup wraps a checker to count)
+        ss.setup()
+    si = kernels.getSpaceInformation()
+    layout = layout_for(si.getStateSpace())
+    box_checks = checks_for(si, layout)
+    assert box_checks.path == "kernel" and box_checks.exits is False
+    si = callable_world.getSpaceInformation()
+    callable_checks = checks_for(si, layout)
+    assert callable_checks.path == "python" and callable_checks.exits is True
 
 
 def test_a_fresh_processs_first_half_second_solve_returns_in_time():

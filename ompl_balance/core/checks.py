@@ -84,6 +84,14 @@ def exit_target(handle: int) -> Any:
     return _TARGETS[handle]
 
 
+def exits_to_python(view: Any) -> bool:
+    """Whether the kernels of ``view`` may call Python: it, or a view inside it, carries an exit
+    handle (a field ``handle``, by the convention of :func:`exit_handle`'s callers)."""
+    if not (isinstance(view, tuple) and hasattr(view, "_fields")):
+        return False
+    return "handle" in view._fields or any(exits_to_python(field) for field in view)
+
+
 _KERNEL_MODULES: dict[type, str] = {}
 
 View = TypeVar("View", bound=type)

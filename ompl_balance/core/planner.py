@@ -282,12 +282,13 @@ class TreePlanner(ob.Planner):
 
     # -- output ----------------------------------------------------------------------
 
-    def _add_solution(self, points: Points, path_points: Iterable[Any]) -> None:
-        """Add the path through ``path_points`` (in order) to the problem definition as exact."""
+    def _add_solution(self, points: Points, path_points: Iterable[Any]) -> og.PathGeometric:
+        """Add the path through ``path_points`` (in order) to the problem definition as exact; returns it."""
         path = og.PathGeometric(self.getSpaceInformation())
         for point in path_points:
             path.append(points.ompl_state(point))
         self.getProblemDefinition().addSolutionPath(path, False, 0.0, self.getName())
+        return path
 
     @_ForPythonCallers
     def getPlannerData(self, data: ob.PlannerData) -> None:  # noqa: N802 (OMPL's name)

@@ -180,17 +180,19 @@ def _grown(array: np.ndarray, rows: int) -> np.ndarray:
 
 
 @contextlib.contextmanager
-def interrupts_between_slices() -> Iterator[Callable[[], None]]:
+def interrupts_between_slices(exits: bool) -> Iterator[Callable[[], None]]:
     """Ctrl-C during a compiled solve, raised between slices: yields ``check()``, which raises
     ``KeyboardInterrupt`` if SIGINT came since the last call.
 
     Python raises ``KeyboardInterrupt`` wherever its interpreter next runs, which in a compiled
     slice is inside a kernel's ``objmode`` exit to Python; numba does not carry an exception out
-    of there safely (a process could crash). So while the solve runs, SIGINT only sets a flag
-    (main thread only: Python delivers signals there; elsewhere nothing changes).
+    of there safely (a process could crash). So while a solve whose kernels may call Python
+    (``exits``) runs, SIGINT only sets a flag (main thread only: Python delivers signals there;
+    elsewhere nothing changes). Without exits the interpreter next runs after the slice, where
+    ``KeyboardInterrupt`` is safe, and the handler stays as it was.
     """
     caught: list[int] = []
-    if threading.current_thread() is not threading.main_thread():
+    if not exits or threading.current_thread() is not threading.main_thread():
         yield lambda: None
         return
 
@@ -221,7 +223,7 @@ def run(
     settings = arrays.settings_for(solve)
     arrays.start(solve, room, settings.record)
     layout, ints, reals = arrays.layout, arrays.loop.ints, arrays.loop.reals
-    state = solve.tree_choice.state
+    state = solve.swap_state
     ints[Slot.GREW_START], ints[Slot.STEPS], ints[Slot.COLLIDED] = state.grew_start, state.steps, state.collided
     ints[Slot.NEXT_SAMPLE] = SAMPLE_BLOCK  # a fresh block at the first sample, as the Python engine's
     ints[Slot.ROOM] = room
@@ -239,7 +241,7 @@ def run(
         ints[Slot.GOAL_FED] = 1
         return True
 
-    with interrupts_between_slices() as raise_interrupt:
+    with interrupts_between_slices(checks.exits) as raise_interrupt:
         try:
             while not ptc():
                 # (a slice's first iteration asks here rather than by a stop, a slice the fewer)
@@ -270,7 +272,7 @@ def run(
 def _report(solve: Solve, arrays: loop.Loop, exits: int) -> None:
     """Hand what the compiled loop did to the planner's side: swap state, counts, gap, record."""
     ints, reals = arrays.ints, arrays.reals
-    state = solve.tree_choice.state
+    state = solve.swap_state
     state.grew_start, state.steps, state.collided = (
         bool(ints[Slot.GREW_START]),
         int(ints[Slot.STEPS]),
@@ -304,25 +306,14 @@ def warm_up(view: object, layout: SpaceLayout) -> None:
     """Compile :func:`ompl_balance.engine.loop.run` for ``view``'s kind of checks (or load it from
     numba's cache): a call of no iterations with arrays of the types a solve passes."""
     settings = loop.Settings(1.0, False, False, True, 1.0, 0, 1, 0, 1, 1, 0, 0.0, 0.0, 0.0, False)
-    dim = layout.dim
     tree = loop.Tree(
-        np.zeros((1, dim)),
+        np.zeros((1, layout.dim)),
         np.zeros(1, dtype=np.int64),
         np.zeros(1, dtype=np.int64),
         np.zeros(1, dtype=np.int64),
         np.zeros(1),
         new_index(layout, 1),
     )
-    arrays = loop.Loop(
-        sizes=np.zeros(2, dtype=np.int64),
-        ints=np.zeros(Slot.COUNT, dtype=np.int64),
-        reals=np.zeros(Real.COUNT),
-        block=np.empty((SAMPLE_BLOCK, dim)),
-        uniforms=np.empty((SAMPLE_BLOCK, layout.total_draws)),
-        step=np.empty(dim),
-        target=np.empty(dim),
-        record=np.empty((0, Record.COUNT), dtype=np.int64),
-        record_target=np.empty((0, dim)),
-    )
+    arrays = SolveArrays(layout).loop
     rng = np.random.default_rng(0)
     loop.run(view, layout, settings, (tree, tree), arrays, bit_generator_address(rng), 0)

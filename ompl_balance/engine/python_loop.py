@@ -93,7 +93,8 @@ def run(solve: Solve, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus.P
     says stop (``TIMEOUT``) or no goal state can be had (``INVALID_GOAL``)."""
     settings, points, counts = solve.settings, solve.points, solve.counts
     start_tree, goal_tree = solve.start_tree, solve.goal_tree
-    choice, targets, record = solve.tree_choice, solve.targets, solve.record
+    choice, nearest, targets = solve.policies()
+    record = solve.record
     extender = Extender(
         points,
         settings.range,
@@ -101,7 +102,7 @@ def run(solve: Solve, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus.P
         solve.si.isValid,
         solve.si.checkMotion,
         points.may_stall(settings.range),
-        solve.nearest,
+        nearest,
         record,
     )
     plain_nearest = settings.nearest_policy == "euclidean"

@@ -1,16 +1,17 @@
 """One solve of an RRT-Connect planner, as both engines see it.
 
 :class:`Solve` holds what the planner hands an engine for one ``solve()``: the trees and
-what its policies keep across solves, this solve's policies and settings, the planner
-input states and the goal, and what the engine reports back (counts, the gap between the
-trees, the record). Goal feeding and the acceptance of a connection are the same for both
+what its policies keep across solves, this solve's settings (and, for the Python engine, its
+policies as objects), the planner input states and the goal, and what the engine reports
+back (counts, the gap between the trees, the record). Goal feeding and the acceptance of a connection are the same for both
 engines, so they live here.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from ompl import base as ob
@@ -19,8 +20,17 @@ from ompl import util as ou
 from ..core.planner import Progress
 from ..core.spaces import Points
 from ..core.trees import Tree
-from ..policies import NearestChoice, NodeFailures, SampleContext, SamplerCounts, TargetChoice, TreeChoice
+from ..policies import NearestChoice, NodeFailures, SamplerCounts, SwapState, TargetChoice, TreeChoice
 from .events import LoopCounts, LoopRecord
+
+
+class LoopPolicies(NamedTuple):
+    """A solve's policies as the Python engine calls them (the compiled engine reads the
+    same rules from the settings)."""
+
+    tree_choice: TreeChoice  # which tree grows next
+    nearest: NearestChoice  # which node extends towards a target
+    targets: TargetChoice  # where an iteration's target comes from
 
 
 @dataclass
@@ -34,22 +44,17 @@ class Solve:
     start_tree: Tree
     goal_tree: Tree
     failures: dict[Tree, NodeFailures]  # per tree, kept across solves
-    tree_choice: TreeChoice
-    nearest: NearestChoice
-    targets: TargetChoice
-    sample_context: SampleContext
+    swap_state: SwapState  # what the tree choice remembers, kept across solves
+    policies: Callable[[], LoopPolicies]  # this solve's policies, made when the Python engine runs
     inputs: ob.PlannerInputStates
     goal: ob.GoalSampleableRegion
     progress: Progress
     rng: np.random.Generator  # the solve's random numbers (the targets' samples and draws)
     record: LoopRecord | None = None
     counts: LoopCounts = field(default_factory=LoopCounts)
+    sampler_counts: SamplerCounts = field(default_factory=SamplerCounts)  # what the sample policy did
     tree_gap: float = float("inf")  # least distance between the trees seen after a connect
     connection: tuple[int, int] | None = None  # (start node, goal node) of the accepted connection
-
-    @property
-    def sampler_counts(self) -> SamplerCounts:
-        return self.sample_context.counts
 
     def wants_goal(self) -> bool:
         """OMPL's rule: goal states join the goal tree while fewer than half of its states were

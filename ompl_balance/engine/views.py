@@ -24,7 +24,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from ompl import base as ob
 
-from ..core.checks import exit_handle, exit_target, kernels_in, new_counts
+from ..core.checks import exit_handle, exit_target, exits_to_python, kernels_in, new_counts
 from ..core.layout import SpaceLayout
 
 
@@ -87,12 +87,13 @@ class EngineChecks:
     ``path`` says how the checks are made: ``"kernel"`` (compiled kernels, leaving to Python
     only for what they cannot decide) or ``"python"`` (``si.isValid``/``si.checkMotion``).
     ``source``: the objects it was made from (validity checker, motion validator, their compiled
-    view, the layout), by identity.
+    view, the layout), by identity. ``exits``: whether its kernels may call Python.
     """
 
     def __init__(self, view: Any, path: str, source: tuple[Any, ...], keep: Any = None) -> None:
         self.view = view
         self.path = path
+        self.exits = exits_to_python(view)
         self.source = source
         self.keep = keep  # the object behind the view's exit handle (held weakly by the registry)
 
