@@ -3,8 +3,8 @@
 :class:`Solve` holds what the planner hands an engine for one ``solve()``: the trees and
 what its policies keep across solves, this solve's settings (and, for the Python engine, its
 policies as objects), the planner input states and the goal, and what the engine reports
-back (counts, the gap between the trees, the record). Goal feeding and the acceptance of a connection are the same for both
-engines, so they live here.
+back (counts, the gap between the trees, the record). Goal feeding and the acceptance of a
+connection are the same for both engines, so they live here.
 """
 
 from __future__ import annotations
