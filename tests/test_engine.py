@@ -8,6 +8,7 @@ process's first solve are tested on their own.
 
 from __future__ import annotations
 
+import functools
 import math
 import signal
 import subprocess
@@ -564,6 +565,33 @@ def test_check_views_say_whether_their_kernels_call_python():
     si = callable_world.getSpaceInformation()
     callable_checks = checks_for(si, layout)
     assert callable_checks.path == "python" and callable_checks.exits is True
+
+
+@pytest.mark.parametrize("motion", ["certified", "discrete"])
+@pytest.mark.parametrize(
+    "make",
+    [
+        functools.partial(robot_setup, scene="bookshelf_small", problem_index=3),
+        functools.partial(rigid_setup, "se2_slot"),
+    ],
+    ids=["panda", "rigid body"],
+)
+def test_the_robot_and_rigid_body_views_call_python_for_fcl(make, motion):
+    """The robot and rigid-body checkers' kernels leave to FCL through an exit (pairs their bounds
+    cannot decide), so their solves take SIGINT over; a solve's counted exits show the calls."""
+    from ompl_balance.engine.views import checks_for
+
+    ss = make(motion=motion)()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    planner.setSeed(1)
+    ss.setPlanner(planner)
+    ss.setup()
+    si = ss.getSpaceInformation()
+    checks = checks_for(si, layout_for(si.getStateSpace()))
+    assert checks.path == "kernel" and checks.exits is True
+    assert ss.solve(20.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.stats.checks == "kernel" and planner.stats.exits > 0
 
 
 def test_a_fresh_processs_first_half_second_solve_returns_in_time():

@@ -25,9 +25,11 @@ whose sizes are :data:`BLOCK` times the powers of two in ``BUILT / BLOCK``, larg
 its own k-d tree; the fewer than :data:`BLOCK` nodes added since are scanned. When
 :data:`BLOCK` more nodes arrive, the blocks that the binary count changes are built again as
 one (as a binary counter carries), so each node is rebuilt at most ``log2(n / BLOCK)`` times
-and a query's cost grows with the logarithm of the tree, not with its size. A query
-descends each block towards its own coordinates first and skips a subtree whose bound, from
-how far the query lies outside it along each axis, is above the best distance found. The answer is the linear scan's, node for
+and a query's cost grows with the logarithm of the tree, not with its size. Each k-d tree
+splits its nodes at the median until :data:`LEAF` or fewer are left, and keeps each subtree's
+bounding box (the least and greatest index coordinates of its nodes). A query descends each
+block towards its own coordinates first, skips a subtree whose box lies farther than the best
+distance found, and scans a leaf's few nodes. The answer is the linear scan's, node for
 node: the least distance, and the lowest index among equal ones (subtrees are skipped only
 when strictly farther). A quaternion not of unit length (to :data:`UNIT_TOLERANCE`) leaves
 the rotation out of the bounds of that build or query.
@@ -50,6 +52,8 @@ INDEX_FROM = 256
 #: Nodes per unit of the logarithmic method: the built blocks are this many times a power of
 #: two, and a query scans fewer than this many nodes added since the last build.
 BLOCK = 64
+#: Nodes a k-d tree leaves unsplit: a query scans them (cheaper than descending to each).
+LEAF = 8
 #: Depth of a query's stack: the blocks' subtrees pending (one per block, at most 62) and one
 #: path down a k-d tree of up to 2**62 nodes.
 STACK = 128
@@ -84,17 +88,19 @@ class KDIndex(NamedTuple):
     not the tree's scattered states; ``axes``: up to 3 of a position and 4 of a rotation,
     ``ints[Setting.AXES]``); ``coordinates`` (capacity, axes): each node's, by node
     (the build's scratch); ``axis`` (capacity,): the splitting axis at the middle of each
-    subtree of two nodes or more; ``stack`` (STACK, 2) and ``gaps`` (STACK, axes): a query's
-    pending subtrees and, per axis, how far the query lies outside each; ``query`` (axes,):
-    the query's index coordinates; ``weight`` (2,): the position's and the rotation's weights.
+    subtree of more than :data:`LEAF` nodes; ``low``, ``high`` (capacity, axes): the bounding
+    box of each subtree's index coordinates, at its middle (no two subtrees share one);
+    ``stack`` (STACK, 2): a query's pending subtrees; ``query`` (axes,): the query's index
+    coordinates; ``weight`` (2,): the position's and the rotation's weights.
     """
 
     order: np.ndarray
     points: np.ndarray
     coordinates: np.ndarray
     axis: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
     stack: np.ndarray
-    gaps: np.ndarray
     query: np.ndarray
     ints: np.ndarray
     weight: np.ndarray
@@ -131,8 +137,9 @@ def new_index(layout: SpaceLayout, capacity: int) -> KDIndex:
         np.zeros((rows, axes)),
         np.zeros((rows, axes)),
         np.zeros(rows, dtype=np.int64),
+        np.zeros((rows, axes)),
+        np.zeros((rows, axes)),
         np.zeros((STACK, 2), dtype=np.int64),
-        np.zeros((STACK, axes)),
         np.zeros(axes),
         ints,
         weight,
@@ -151,7 +158,12 @@ def grown(index: KDIndex, capacity: int) -> KDIndex:
         return bigger
 
     return index._replace(
-        order=more(index.order), points=more(index.points), coordinates=more(index.coordinates), axis=more(index.axis)
+        order=more(index.order),
+        points=more(index.points),
+        coordinates=more(index.coordinates),
+        axis=more(index.axis),
+        low=more(index.low),
+        high=more(index.high),
     )
 
 
@@ -272,8 +284,9 @@ def _select(order: np.ndarray, values: np.ndarray, column: int, lo: int, hi: int
 @njit(cache=True)
 def _build(index: KDIndex, lo: int, hi: int) -> None:  # pragma: no cover (compiled)
     """The k-d tree of block ``lo .. hi - 1`` (nodes with their index coordinates worked out),
-    in ``order[lo:hi]``, ``points[lo:hi]``, ``axis[lo:hi]``: each subtree split at its median along
-    its widest axis (spreads weighted as their part of the distance)."""
+    in ``order[lo:hi]``, ``points[lo:hi]``, ``axis[lo:hi]``, ``low[lo:hi]``, ``high[lo:hi]``: each
+    subtree's bounding box, and each subtree of more than :data:`LEAF` nodes split at its median
+    along its widest axis (spreads weighted as their part of the distance)."""
     order, coordinates, ints = index.order, index.coordinates, index.ints
     axes, position_axes = ints[Setting.AXES], ints[Setting.POSITION_AXES]
     for node in range(lo, hi):
@@ -284,18 +297,19 @@ def _build(index: KDIndex, lo: int, hi: int) -> None:  # pragma: no cover (compi
     while depth > 0:
         depth -= 1
         first, last = stack[depth, 0], stack[depth, 1]
-        if last - first < 2:
-            continue
+        middle = (first + last) // 2
         widest, spread = 0, -1.0
         for axis in range(axes):
             smallest, largest = np.inf, -np.inf
             for i in range(first, last):
                 value = coordinates[order[i], axis]
                 smallest, largest = min(smallest, value), max(largest, value)
+            index.low[middle, axis], index.high[middle, axis] = smallest, largest
             weighted = (largest - smallest) * index.weight[0 if axis < position_axes else 1]
             if weighted > spread:
                 widest, spread = axis, weighted
-        middle = (first + last) // 2
+        if last - first <= LEAF:
+            continue  # a leaf: its nodes are scanned
         _select(order, coordinates, widest, first, last, middle)
         index.axis[middle] = widest
         stack[depth, 0], stack[depth, 1] = first, middle
@@ -352,6 +366,22 @@ def indexed_nearest(
 
 
 @njit(cache=True, inline="always")
+def _squared_gaps(
+    low: np.ndarray, high: np.ndarray, row: int, at: np.ndarray, position_axes: int, axes: int
+) -> tuple[float, float]:  # pragma: no cover (compiled)
+    """The squared distances (position, rotation) from index coordinates ``at`` (axes,) to the
+    box ``low[row] .. high[row]`` (a point when ``low`` and ``high`` are one array)."""
+    position_squared = rotation_squared = 0.0
+    for k in range(axes):
+        gap = max(low[row, k] - at[k], at[k] - high[row, k], 0.0)
+        if k < position_axes:
+            position_squared += gap * gap
+        else:
+            rotation_squared += gap * gap
+    return position_squared, rotation_squared
+
+
+@njit(cache=True, inline="always")
 def _search(
     index: KDIndex, layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray, euclidean: bool
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
@@ -363,52 +393,39 @@ def _search(
     best, best_key = _scan(layout, euclidean, states, built, size, query, position, position_axes, weight[0])
     at = index.query
     rotations = _index_coordinates(index, query, at) and ints[Setting.UNIT_ROTATIONS] == 1
-    order, points, stack, gaps = index.order, index.points, index.stack, index.gaps
+    order, points, stack, low, high = index.order, index.points, index.stack, index.low, index.high
     # the blocks pushed smallest first, so the largest (the likeliest to hold the nearest) is popped first
     depth, units, hi, bit = 0, built // BLOCK, built, 0
     while units >> bit:
         if units >> bit & 1:
             stack[depth, 0], stack[depth, 1] = hi - (BLOCK << bit), hi
             hi -= BLOCK << bit
-            for k in range(axes):
-                gaps[depth, k] = 0.0
             depth += 1
         bit += 1
     while depth > 0:
         depth -= 1
         lo, hi = stack[depth, 0], stack[depth, 1]
-        if lo >= hi:
-            continue
-        position_squared = rotation_squared = 0.0
-        for k in range(position_axes):
-            position_squared += gaps[depth, k] * gaps[depth, k]
-        for k in range(position_axes, axes):
-            rotation_squared += gaps[depth, k] * gaps[depth, k]
+        middle = (lo + hi) // 2
+        position_squared, rotation_squared = _squared_gaps(low, high, middle, at, position_axes, axes)
         if _bound(euclidean, position_squared, rotation_squared, weight, rotations) > best_key:
             continue  # every node of the subtree is farther than the best (ties are looked at)
-        middle = (lo + hi) // 2
-        node = order[middle]
-        position_squared = rotation_squared = 0.0
-        for k in range(position_axes):
-            position_squared += (points[middle, k] - at[k]) ** 2
-        for k in range(position_axes, axes):
-            rotation_squared += (points[middle, k] - at[k]) ** 2
-        if _bound(euclidean, position_squared, rotation_squared, weight, rotations) <= best_key:
-            key = _key(layout, euclidean, states, node, query, position, position_axes, weight[0], best_key)
-            if key < best_key or (key == best_key and node < best):
-                best, best_key = node, key
-        if hi - lo == 1:
-            continue  # a leaf: no subtrees
+        # a leaf's nodes, or the splitting node of a larger subtree
+        first, last = (lo, hi) if hi - lo <= LEAF else (middle, middle + 1)
+        for row in range(first, last):
+            position_squared, rotation_squared = _squared_gaps(points, points, row, at, position_axes, axes)
+            if _bound(euclidean, position_squared, rotation_squared, weight, rotations) <= best_key:
+                node = order[row]
+                key = _key(layout, euclidean, states, node, query, position, position_axes, weight[0], best_key)
+                if key < best_key or (key == best_key and node < best):
+                    best, best_key = node, key
+        if hi - lo <= LEAF:
+            continue
         axis = index.axis[middle]
-        gap = at[axis] - points[middle, axis]
-        near_lo, near_hi, far_lo, far_hi = (lo, middle, middle + 1, hi) if gap < 0.0 else (middle + 1, hi, lo, middle)
-        if far_lo < far_hi:  # the far side first: the near side is popped first
-            stack[depth, 0], stack[depth, 1] = far_lo, far_hi
-            for k in range(axes):  # the near side's gaps are the subtree's: pushed next
-                gaps[depth + 1, k] = gaps[depth, k]
-            gaps[depth, axis] = max(gaps[depth, axis], abs(gap))
-            depth += 1
-        if near_lo < near_hi:
-            stack[depth, 0], stack[depth, 1] = near_lo, near_hi
-            depth += 1
+        if at[axis] < points[middle, axis]:  # the far side pushed first: the near side is popped first
+            stack[depth, 0], stack[depth, 1] = middle + 1, hi
+            stack[depth + 1, 0], stack[depth + 1, 1] = lo, middle
+        else:
+            stack[depth, 0], stack[depth, 1] = lo, middle
+            stack[depth + 1, 0], stack[depth + 1, 1] = middle + 1, hi
+        depth += 2
     return best, best_key
