@@ -11,12 +11,14 @@ when the wait exceeds a second.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pickle
 import sys
 import threading
 import time
 from collections.abc import Callable, Hashable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -79,6 +81,19 @@ def _view_key(value: Any) -> Any:
     return type(value)
 
 
+def key_text(key: Any) -> str:
+    """``key`` (a :func:`view_key`) as text that is the same in every process: classes by their
+    module and name rather than by identity."""
+    if isinstance(key, _Key):
+        kind, fields = key.items
+        return key_text(kind) + key_text(fields)
+    if isinstance(key, tuple):
+        return "(" + ",".join(key_text(item) for item in key) + ")"
+    if isinstance(key, type):
+        return f"{key.__module__}.{key.__qualname__}"
+    return repr(key)
+
+
 class EngineLoader:
     """Background compilation of the engine's specializations, one thread per kind of view."""
 
@@ -108,19 +123,20 @@ class EngineLoader:
         return True
 
     def wait(self, key: Hashable, warm: Callable[[], None], what: str) -> None:
-        """Make the engine for ``key`` ready now, saying on standard error when that takes more than a second."""
+        """Make the engine for ``key`` ready now (compiled, or loaded from numba's cache), saying on
+        standard error when that takes more than a second."""
         self.start(key, warm)
         thread = self._threads[key]
         began = time.perf_counter()
         thread.join(QUIET_WAIT)
         if thread.is_alive():
             sys.stderr.write(
-                f"ompl_balance: compiling the planning engine for {what} (once: later processes load it from "
-                "numba's cache)...\n"
+                f"ompl_balance: preparing the planning engine for {what} (numba compiles it on first use, tens "
+                "of seconds; later processes load it from numba's cache, a second or two)...\n"
             )
             sys.stderr.flush()
             thread.join()
-            sys.stderr.write(f"ompl_balance: compiled in {time.perf_counter() - began:.0f} s\n")
+            sys.stderr.write(f"ompl_balance: planning engine ready after {time.perf_counter() - began:.0f} s\n")
         if key in self._errors:
             raise RuntimeError(f"the compiled engine for {what} failed to compile") from self._errors[key]
 
@@ -146,7 +162,9 @@ class EngineLoader:
 
 
 def forget_cached_kernels() -> None:
-    """Empty numba's on-disk cache index of every compiled function of the package loaded so far."""
+    """Empty numba's on-disk cache index of every compiled function of the package loaded so far,
+    and remove the markers of engines loaded from it (``engine-*.loaded`` beside it, see
+    :func:`~ompl_balance.engine.compiled.loaded_marker`): the next load compiles in the compile worker."""
     from numba.core.dispatcher import Dispatcher
 
     for name, module in list(sys.modules.items()):
@@ -156,6 +174,10 @@ def forget_cached_kernels() -> None:
             cache = getattr(value, "_cache", None) if isinstance(value, Dispatcher) else None
             if cache is not None:
                 cache.flush()
+                cache_path = getattr(cache, "_cache_path", None)
+                for marker in Path(cache_path).glob("engine-*.loaded") if cache_path else ():
+                    with contextlib.suppress(OSError):
+                        marker.unlink()
 
 
 LOADER = EngineLoader()
