@@ -615,41 +615,6 @@ def test_a_fresh_processs_first_half_second_solve_returns_in_time():
     assert elapsed < 1.0
 
 
-def test_a_process_loads_an_engine_a_process_loaded_before_without_the_compile_worker():
-    """The first process to load an engine from numba's cache leaves a marker beside it; later
-    processes load it directly, without starting the compile worker."""
-    script = textwrap.dedent(
-        """
-        import subprocess
-        from ompl import util as ou
-        ou.setLogLevel(ou.LOG_WARN)
-        from ompl_balance import BalancedRRTConnect, get_problem
-        from ompl_balance.engine import compiled
-        workers = []
-        run = subprocess.run
-        def counted(arguments, **keywords):
-            if "ompl_balance.engine.compile_worker" in arguments:
-                workers.append(arguments)
-            return run(arguments, **keywords)
-        compiled.subprocess.run = counted
-        ss = get_problem("maze").setup()
-        planner = BalancedRRTConnect(ss.getSpaceInformation())
-        planner.setEngine("compiled")
-        ss.setPlanner(planner)
-        ss.setup()
-        assert ss.solve(5.0) and planner.stats.engine == "compiled"
-        print(len(workers))
-        """
-    )
-
-    def compile_workers_started() -> int:
-        done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
-        return int(done.stdout.split()[-1])
-
-    assert compile_workers_started() in (0, 1)  # 0 where an earlier process loaded it
-    assert compile_workers_started() == 0
-
-
 # -- what the compiled engine refuses -------------------------------------------------------------
 
 

@@ -11,7 +11,6 @@ plans on the compiled engine never loads it.
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import importlib
 import math
 import pickle
@@ -29,7 +28,7 @@ from ompl import util as ou
 from ..core.checks import kernel_modules
 from ..core.layout import SpaceLayout
 from ..core.trees import Tree
-from .loading import LOADER, key_text, view_key
+from .loading import LOADER, view_key
 from .solve import Solve
 from .views import EngineChecks, checks_for
 
@@ -53,21 +52,17 @@ def room_per_iteration(layout: SpaceLayout, extent: float, step: float, intermed
 def _warm(view: Any, layout: SpaceLayout) -> None:
     """Make the engine for ``view`` and ``layout`` ready in this process: compiled into numba's
     cache by another process (:mod:`ompl_balance.engine.compile_worker`; a compilation takes tens
-    of seconds, mostly in Python, and would hold this interpreter), then loaded from it here. The
-    other process is skipped where :func:`loaded_marker` says a process has loaded this engine
-    from the cache before (starting it costs a second or two of every process's wait)."""
-    marker = loaded_marker(view, layout)
-    if marker is None or not marker.exists():
-        try:
-            with _compile_lock():  # one compilation at a time on the machine: the next one finds it cached
-                subprocess.run(
-                    [sys.executable, "-m", "ompl_balance.engine.compile_worker"],
-                    input=pickle.dumps((view, layout)),
-                    capture_output=True,
-                    check=True,
-                )
-        except (OSError, subprocess.SubprocessError, pickle.PicklingError):
-            pass  # compiled here instead
+    of seconds, mostly in Python, and would hold this interpreter), then loaded from it here."""
+    try:
+        with _compile_lock():  # one compilation at a time on the machine: the next one finds it cached
+            subprocess.run(
+                [sys.executable, "-m", "ompl_balance.engine.compile_worker"],
+                input=pickle.dumps((view, layout)),
+                capture_output=True,
+                check=True,
+            )
+    except (OSError, subprocess.SubprocessError, pickle.PicklingError):
+        pass  # compiled here instead
     modules = [importlib.import_module(module) for module in kernel_modules(view)]
     from .driver import warm_up
 
@@ -76,26 +71,6 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
         warm_exits = getattr(module, "warm_exits", None)
         if warm_exits is not None:
             warm_exits()
-    if marker is not None:
-        with contextlib.suppress(OSError):
-            marker.touch()
-
-
-def loaded_marker(view: Any, layout: SpaceLayout) -> Path | None:
-    """The file beside the planning loop's numba cache that a process writes once it has loaded the
-    engine for this kind of ``view`` and ``layout`` from the cache; its name holds the package's
-    source digest, numba's and Python's versions and the view's key, which decide whether the
-    cache still holds that engine. ``None`` where numba keeps no cache path for the loop."""
-    from ..core.kernel_cache import package_digest
-    from .loop import run
-
-    cache_path = getattr(getattr(run, "_cache", None), "_cache_path", None)
-    if cache_path is None:
-        return None
-    import numba
-
-    key = f"{package_digest()}|{numba.__version__}|{sys.version_info[:2]}|{key_text(view_key((view, layout)))}"
-    return Path(cache_path) / f"engine-{hashlib.sha256(key.encode()).hexdigest()[:32]}.loaded"
 
 
 def runs_compiled(checks: EngineChecks, engine: str) -> bool:

@@ -11,14 +11,12 @@ when the wait exceeds a second.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import pickle
 import sys
 import threading
 import time
 from collections.abc import Callable, Hashable
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -79,19 +77,6 @@ def _view_key(value: Any) -> Any:
     if isinstance(value, np.ndarray):
         return (value.dtype.str, value.ndim, value.flags.c_contiguous, value.flags.writeable)
     return type(value)
-
-
-def key_text(key: Any) -> str:
-    """``key`` (a :func:`view_key`) as text that is the same in every process: classes by their
-    module and name rather than by identity."""
-    if isinstance(key, _Key):
-        kind, fields = key.items
-        return key_text(kind) + key_text(fields)
-    if isinstance(key, tuple):
-        return "(" + ",".join(key_text(item) for item in key) + ")"
-    if isinstance(key, type):
-        return f"{key.__module__}.{key.__qualname__}"
-    return repr(key)
 
 
 class EngineLoader:
@@ -162,9 +147,7 @@ class EngineLoader:
 
 
 def forget_cached_kernels() -> None:
-    """Empty numba's on-disk cache index of every compiled function of the package loaded so far,
-    and remove the markers of engines loaded from it (``engine-*.loaded`` beside it, see
-    :func:`~ompl_balance.engine.compiled.loaded_marker`): the next load compiles in the compile worker."""
+    """Empty numba's on-disk cache index of every compiled function of the package loaded so far."""
     from numba.core.dispatcher import Dispatcher
 
     for name, module in list(sys.modules.items()):
@@ -174,10 +157,6 @@ def forget_cached_kernels() -> None:
             cache = getattr(value, "_cache", None) if isinstance(value, Dispatcher) else None
             if cache is not None:
                 cache.flush()
-                cache_path = getattr(cache, "_cache_path", None)
-                for marker in Path(cache_path).glob("engine-*.loaded") if cache_path else ():
-                    with contextlib.suppress(OSError):
-                        marker.unlink()
 
 
 LOADER = EngineLoader()
