@@ -1,6 +1,6 @@
 """The compiled engine against the Python engine and stock OMPL, measured in one run.
 
-Five parts (``--part``), each printing a table of medians and ratios measured in the same
+Six parts (``--part``), each printing a table of medians and ratios measured in the same
 run, planners interleaved run by run so that the machine's slow phases hit all of them. The
 two engines get the same seed in each run, so they make the same trees: their time ratio is
 the engines' speed alone.
@@ -29,6 +29,14 @@ the engines' speed alone.
     policies, the path, the statistics), and ``SimpleSetup.solve`` around the planner (with a
     time limit of a second or more, OMPL evaluates it in a thread of its own, which the solve
     waits for at its end).
+``edges``
+    What a certified Panda edge costs by how it ends: the edges of the same runs (the Python
+    engine's, on the seeds of the ``profile`` part), replayed in order through the certified
+    motion kernel with a fresh certifier per problem, each timed in compiled code. Edges are
+    accepted or refused in the kernel, or after its call out to Python (FCL's exact distance on
+    the segments of non-convex geometries the kernel could not bound); per kind: its share of the
+    edges and of their time, microseconds per edge, and the configurations and distance bounds
+    (GJK) the kernel evaluated per edge.
 ``scaling``
     The cost of an iteration as the trees grow to tens of thousands of nodes, in R^2 and SE(3)
     (a box world and a rigid body, each cut in two by a wall so that both trees grow freely
@@ -43,7 +51,7 @@ the engines' speed alone.
 Each part starts with the objects the script made before it set aside (``gc.freeze``), so that
 Python's collector walking them is not charged to the planners of the part.
 
-Run: ``python benchmarks/bench_engine.py [--part panda,2d,profile,scaling,index] [--problems 25] [--runs 1]``
+Run: ``python benchmarks/bench_engine.py [--part panda,2d,profile,edges,scaling,index] [--problems 25] [--runs 1]``
 """
 
 from __future__ import annotations
@@ -362,6 +370,72 @@ def profile(args) -> None:
         )
 
 
+#: How a certified edge ends: (accepted, after a call out to Python).
+EDGE_OUTCOMES = {
+    (False, False): "refused in the kernel",
+    (False, True): "refused after FCL",
+    (True, False): "accepted in the kernel",
+    (True, True): "accepted after FCL",
+}
+
+
+def edge_costs(args) -> None:
+    """What a certified edge costs by how it ends (see the module docstring)."""
+    from numba import njit
+
+    from ompl_balance.collision.kernels import certified_motion_free
+    from ompl_balance.core.checks import Count
+    from ompl_balance.engine.clock import monotonic_ns
+
+    @njit
+    def replay(view, starts, ends, free, work, nanoseconds):  # a run's edges in order, each timed
+        for i in range(starts.shape[0]):
+            before = view.counts.copy()
+            began = monotonic_ns()
+            free[i] = certified_motion_free(view, starts[i], ends[i])
+            nanoseconds[i] = monotonic_ns() - began
+            work[i] = view.counts - before
+
+    robot = load_panda_vamp()
+    print(
+        f"\nWhat a certified edge costs by how it ends: first {args.problems} problems per scenario, the edges "
+        "of the Python engine's runs replayed through the kernel\n"
+    )
+    print(
+        "| scenario | edges | how they end | share of the edges | share of their time | us / edge "
+        "| configurations / edge | distance bounds / edge |\n|---|---|---|---|---|---|---|---|"
+    )
+    for scenario in SCENARIOS:
+        free_parts, work_parts, time_parts = [], [], []
+        for problem in load_mbm(scenario, robot.joint_names)[: args.problems]:
+            with recorded_checks() as (edges, _states):
+                seeded_solve(robot, problem, "python", 1 + problem.id, args.time_limit)
+            if not edges:
+                continue
+            certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))
+            view = certifier.compiled_view()  # (its calls out to Python find the certifier while it lives)
+            starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
+            free, work = np.zeros(len(edges), dtype=np.bool_), np.zeros((len(edges), len(Count)), dtype=np.int64)
+            nanoseconds = np.zeros(len(edges), dtype=np.int64)
+            replay(view, starts[:0], ends[:0], free, work, nanoseconds)  # compiled before the timing
+            replay(view, starts, ends, free, work, nanoseconds)
+            free_parts.append(free)
+            work_parts.append(work)
+            time_parts.append(nanoseconds)
+        free, work, nanoseconds = np.concatenate(free_parts), np.concatenate(work_parts), np.concatenate(time_parts)
+        exited = work[:, Count.EXITS] > 0
+        for (accepted, after_fcl), label in EDGE_OUTCOMES.items():
+            kind = (free == accepted) & (exited == after_fcl)
+            if not kind.any():
+                continue
+            print(
+                f"| {scenario} | {len(free)} | {label} | {kind.mean():.0%} | {nanoseconds[kind].sum() / nanoseconds.sum():.0%} "
+                f"| {nanoseconds[kind].mean() / 1e3:.0f} | {work[kind, Count.STATES].mean():.1f} "
+                f"| {work[kind, Count.DISTANCE_QUERIES].mean():.1f} |",
+                flush=True,
+            )
+
+
 def split_box_world() -> Callable[[], og.SimpleSetup]:
     """The unit square cut in two by a wall: start and goal on either side, both trees grow freely."""
     return Problem("split", "a wall between start and goal", ((0.48, 0.0, 0.52, 1.0),), (0.1, 0.5), (0.9, 0.5)).setup
@@ -482,8 +556,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--part",
-        default="panda,2d,profile,scaling,index",
-        help="comma-separated parts: panda, 2d, profile, scaling, index",
+        default="panda,2d,profile,edges,scaling,index",
+        help="comma-separated parts: panda, 2d, profile, edges, scaling, index",
     )
     parser.add_argument("--problems", type=int, default=25, help="Panda problems per scenario (default 25)")
     parser.add_argument("--runs", type=int, default=1, help="Panda runs per problem and planner (default 1)")
@@ -504,8 +578,17 @@ def main() -> None:
         # Python objects (the Python engine; calls out to Python), by up to 1.5-2x in a full run.
         gc.collect()
         gc.freeze()
-        {"panda": panda, "2d": two_d, "profile": profile, "scaling": scaling, "index": index}[part](args)
+        parts = {
+            "panda": panda,
+            "2d": two_d,
+            "profile": profile,
+            "edges": edge_costs,
+            "scaling": scaling,
+            "index": index,
+        }
+        parts[part](args)
     gc.unfreeze()
+    gc.collect()  # (OMPL objects in cycles freed before the interpreter exits)
     print(f"\nwhole script: {time.perf_counter() - began:.0f} s; median of runs, ratios of medians")
 
 

@@ -310,6 +310,57 @@ def test_non_convex_meshes_are_finished_with_fcl(monkeypatch):
     check_edges(robot, environment, [edge for colliding, free, *_ in pairs for edge in (colliding, free)])
 
 
+def test_touching_non_convex_parts_are_tested_with_fcl_first(monkeypatch):
+    """Where the hull of the Panda's non-convex link touches an obstacle, the kernel asks FCL about
+    that stretch before certifying the rest of the edge: an edge FCL finds in contact there is
+    refused after a few configurations (not after the whole edge's bisection), and every verdict
+    agrees with the dense re-check. Edges as RRT-Connect extends them: from the problem's start
+    and goals, up to 2.5 rad towards uniform samples."""
+    robot = panda()
+    problem = load_mbm("box", robot.joint_names)[0]
+    assert not all(geometry.shape.convex for geometry in robot.geometries)
+    outcomes = []
+    touch = certified.MotionCertifier.hard_segments_touch
+    monkeypatch.setattr(
+        certified.MotionCertifier,
+        "hard_segments_touch",
+        lambda self, *arguments: outcomes.append(touch(self, *arguments)) or outcomes[-1],
+    )
+    oracle, checker = CollisionChecker(robot, problem.environment), CollisionChecker(robot, problem.environment)
+    certifier = certified.MotionCertifier(checker)
+    rng = np.random.default_rng(7)
+    refused_at_probe = 0
+    for a in [problem.start, *problem.goals] * 100:
+        toward = rng.uniform(robot.lower, robot.upper) - a
+        b = a + toward * min(1.0, 2.5 / np.linalg.norm(toward))
+        probes, states = len(outcomes), checker.counters()["states_checked"]
+        valid, _ = certifier.check(a, b)
+        first = dense_first_collision(oracle, a, b)
+        assert not (valid and first is not None), f"edge certified free collides at t = {first}: {a} -> {b}"
+        if len(outcomes) > probes and outcomes[-1]:
+            assert not valid and first is not None  # FCL's contact is the re-check's
+            assert checker.counters()["states_checked"] - states < 60
+            refused_at_probe += 1
+    assert refused_at_probe >= 3
+
+
+def test_probe_order_visits_every_segment_coarse_to_fine():
+    """Segments are probed once each; the first 2**j - 1 probed leave no run of more than about
+    n / 2**j consecutive segments (along the motion) unprobed."""
+    from ompl_balance.collision.bisection import probe_order
+
+    rng = np.random.default_rng(3)
+    for n in [0, 1, 2, 3, 5, 8, 13, 100, 147]:
+        middles = rng.random(n)
+        order = probe_order(middles)
+        assert sorted(order.tolist()) == list(range(n))
+        ranks = np.argsort(np.argsort(middles))[order]  # the probed segments' places along the motion
+        for j in range(1, max(n, 1).bit_length() + 1):
+            probed = np.sort(ranks[: 2**j - 1])
+            gaps = np.diff(np.concatenate(([-1], probed, [n])))
+            assert gaps.max() - 1 <= int(np.ceil(n / 2**j)), (n, j, probed)
+
+
 # ---------------------------------------------------------------------------------------- work, clearance, input
 
 

@@ -20,7 +20,10 @@ straight line, certified when every cell it crosses is free (:func:`table_span_f
 A pair whose convex parts are its FCL model (primitives, convex meshes) is decided here:
 a GJK upper bound within :data:`DISTANCE_TOLERANCE` of the clearance is a contact. Other
 pairs (a non-convex mesh and its hull) are handed over to FCL's exact distance when a
-segment of travel at most ``handover`` metres still fails (the *hard* segments).
+segment of travel at most ``handover`` metres still fails (the *hard* segments), or, where
+only a yes or no is wanted, as soon as their convex parts touch at a segment's end: there
+the mesh is likeliest in contact, which FCL tells in one test, and the caller may ask FCL
+before the rest of the edge is certified (``probe``).
 """
 
 from __future__ import annotations
@@ -324,6 +327,13 @@ def memory_row(memory: EndMemory, q: np.ndarray) -> int:  # pragma: no cover (co
     return row
 
 
+@njit(cache=True, inline="always")
+def _parts_touch(lower: np.ndarray, final: np.ndarray, clearance: float) -> bool:  # pragma: no cover (compiled)
+    """Whether a segment's convex parts are within ``clearance`` at an end: its lower bound
+    ``lower`` (2,) there at most that, and ``final`` (2,) (GJK's, which cannot be sharpened)."""
+    return (final[0] and lower[0] <= clearance) or (final[1] and lower[1] <= clearance)
+
+
 @njit(cache=True)
 def advance(
     a: np.ndarray,
@@ -334,6 +344,7 @@ def advance(
     end: int,
     settle: float,
     stop: bool,
+    probe: bool,
     scratch: EdgeScratch,
 ) -> tuple[bool, float, int, int, int, np.ndarray, np.ndarray]:  # pragma: no cover (compiled)
     """Certify the edge ``a -> b`` (dof,) for every pair but the hard segments.
@@ -343,6 +354,14 @@ def advance(
     ``stop``: return at the first failure; otherwise a segment reaching a failure found
     earlier is refined to ``settle`` (m) of travel only (where the last certified fraction is
     wanted, not a certificate). ``scratch``: see :class:`EdgeScratch`.
+
+    With ``stop``, a segment of a non-convex pair whose convex parts are within the clearance at
+    an end (GJK's bound there is final) is a hard segment at once, however long: halving it
+    would leave a hard segment at every ``handover`` of travel along the stretch where the parts
+    touch, and most such edges collide there, which FCL finds in one test. ``probe`` (with
+    ``stop``): return undecided (``failed`` False, ``bad`` 0, the hard segments so far) at the
+    end of the first bisection level that hands such a segment over, before the rest of the
+    edge is certified, for the caller to test them first.
 
     Returns ``failed`` (an end outside the joint bounds or not finite, a contact, or a
     segment that cannot be certified), ``bad`` (the edge is certified for all pairs on
@@ -405,6 +424,7 @@ def advance(
         return failed, 0.0, hard, 2, 0, hard_pair, hard_span
     count, level = pairs, 0
     evaluated, bounded = 2, 0
+    touched = False  # a hard segment was handed over where its pair's convex parts touch
     while count > 0:
         width = 0.5**level
         split = np.empty(count, dtype=np.int64)
@@ -447,13 +467,15 @@ def advance(
                     break
             if seg_lower[e, 0] + seg_lower[e, 1] > need or t0 >= bad:
                 continue
-            if not model.solid[pair] and travel <= handover:
+            touching = stop and not model.solid[pair] and _parts_touch(seg_lower[e], seg_final[e], clearance)
+            if (not model.solid[pair] and travel <= handover) or touching:
                 hard_pair = grown(hard_pair, hard + 1)
                 hard_span = grown(hard_span, hard + 1)
                 hard_pair[hard] = pair
                 hard_span[hard, 0], hard_span[hard, 1] = t0, t0 + width
                 hard_span[hard, 2], hard_span[hard, 3] = seg_lower[e, 0], seg_lower[e, 1]
                 hard += 1
+                touched = touched or touching
                 continue
             if travel < floor or level >= MAX_LEVEL or (failed and t0 + width >= bad and travel < settle):
                 failed = True
@@ -514,6 +536,8 @@ def advance(
                     next_lower[child, 1 - side], next_final[child, 1 - side] = lower, final
                 following += 2
             group = last
+        if probe and touched:  # (the level's contacts of convex pairs found first: they cost no FCL test)
+            return False, 0.0, hard, evaluated, bounded, hard_pair, hard_span
         seg_pair, seg_k, seg_point, seg_lower, seg_final = next_pair, next_k, next_point, next_lower, next_final
         count = following
         level += 1

@@ -84,7 +84,7 @@ from .advancement import (
     memory_row,
     sphere_bounds,
 )
-from .bisection import bisect_segments
+from .bisection import bisect_segments, probe_order
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
 from .kernels import CertifiedMotions, certified_edge_free, robot_states
@@ -151,7 +151,7 @@ class MotionCertifier:
         )
         self._row = entry_point(memory_row, (self._memory, lower))
         self._advance = entry_point(
-            advance, (lower, lower, self._edge, self._memory.bounds, 0, 1, MIN_TRAVEL, True, self._scratch)
+            advance, (lower, lower, self._edge, self._memory.bounds, 0, 1, MIN_TRAVEL, True, False, self._scratch)
         )
         self._edge_free = entry_point(
             certified_edge_free, (self._edge, self._memory, self._scratch, checker.counter.array, 0, lower, lower)
@@ -222,7 +222,7 @@ class MotionCertifier:
         settle = max(MIN_TRAVEL, LAST_VALID_TRAVEL) if last_valid else MIN_TRAVEL
         if self.checker.prefilter:
             failed, bad, hard, evaluated, bounded, hard_pair, hard_span = self._advance(
-                a, b, self._edge, self._memory.bounds, start, end, settle, False, self._scratch
+                a, b, self._edge, self._memory.bounds, start, end, settle, False, False, self._scratch
             )
             self.checker.counter.states_checked += evaluated
             self.checker.counter.distance_queries += bounded
@@ -260,6 +260,21 @@ class MotionCertifier:
         kernel's exit."""
         failed, _ = self._exact_phase(a, b, pairs, spans, start, end, MIN_TRAVEL, False, False, 1.0)
         return not failed
+
+    def hard_segments_touch(self, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray) -> bool:
+        """Whether FCL finds a contact in the hard segments ``(pair, (t0, t1, d0, d1))`` of the edge
+        ``a -> b``: a collision test at each end whose bound is within the clearance (where the
+        pair's convex parts touch), then at each middle; the compiled kernel's exit before it
+        certifies the rest of the edge."""
+        delta = b - a
+        for pair, (t0, t1, d0, d1) in zip(pairs.tolist(), spans.tolist()):
+            for t, bound in ((t0, d0), (t1, d1), (0.5 * (t0 + t1), -np.inf)):
+                if bound > self.clearance:
+                    continue
+                self.checker.counter.states_checked += 1
+                if self.checker.pair_touching(pair, self._robot.body_poses(a + t * delta)[0]):
+                    return True
+        return False
 
     def closest(self, q: np.ndarray) -> float:
         """The smallest FCL distance (m) between the collision pairs at configuration ``q`` (dof,).
@@ -340,8 +355,9 @@ class MotionCertifier:
             return exact[pair, t]
 
         if not last_valid:  # contacts first: an FCL collision test costs a few microseconds
-            for pair, (t0, t1, _, _) in zip(pairs.tolist(), spans.tolist()):
-                if self.checker.pair_touching(pair, poses(0.5 * (t0 + t1))):
+            middles = 0.5 * (spans[:, 0] + spans[:, 1])
+            for i in probe_order(middles).tolist():
+                if self.checker.pair_touching(int(pairs[i]), poses(float(middles[i]))):
                     return True, 0.0
         segments = [(pair, t0, t1, d0, d1) for pair, (t0, t1, d0, d1) in zip(pairs.tolist(), spans.tolist())]
         return bisect_segments(

@@ -242,6 +242,10 @@ def _exact(
     return bool(exit_target(handle).hard_segments_free(a, b, pairs, spans, start, end))
 
 
+def _touching(handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray) -> bool:
+    return bool(exit_target(handle).hard_segments_touch(a, b, pairs, spans))
+
+
 @njit(cache=True)
 def certified_edge_free(
     edge: EdgeModel,
@@ -255,16 +259,27 @@ def certified_edge_free(
     """:meth:`MotionCertifier.check` of ``a -> b`` (no ``last_valid``): advancement, stopping at
     the first failure, then FCL on the hard segments through the exit ``handle``. Counts one
     motion, the configurations evaluated and the distance queries in ``counts``. (The parts of
-    a :class:`CertifiedMotions` view it needs, so that Python callers pass no more.)"""
+    a :class:`CertifiedMotions` view it needs, so that Python callers pass no more.)
+
+    Where a non-convex pair's convex parts touch, the advancement stops at once and FCL tests
+    that segment for a contact first (most such edges collide there); only if it finds none
+    is the edge certified in full.
+    """
     counts[Count.MOTIONS] += 1
     start, end = memory_row(memory, a), memory_row(memory, b)
-    failed, _bad, hard, evaluated, bounded, hard_pair, hard_span = advance(
-        a, b, edge, memory.bounds, start, end, edge.floor, True, scratch
-    )
-    counts[Count.STATES] += evaluated
-    counts[Count.DISTANCE_QUERIES] += bounded
-    if failed:
-        return False
+    for probe in (True, False):
+        failed, bad, hard, evaluated, bounded, hard_pair, hard_span = advance(
+            a, b, edge, memory.bounds, start, end, edge.floor, True, probe, scratch
+        )
+        counts[Count.STATES] += evaluated
+        counts[Count.DISTANCE_QUERIES] += bounded
+        if failed:
+            return False
+        if bad == 1.0:  # certified but for the hard segments
+            break
+        counts[Count.EXITS] += 1  # undecided at a touching segment: FCL looks there first
+        if hard_segments_touch(handle, a, b, hard_pair[:hard], hard_span[:hard]):
+            return False
     if hard == 0:
         return True
     counts[Count.EXITS] += 1
@@ -279,6 +294,16 @@ def hard_segments_free(
     with objmode(free="boolean"):
         free = _exact(handle, a, b, pairs, spans, start, end)
     return free
+
+
+@njit(cache=True)
+def hard_segments_touch(
+    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray
+) -> bool:  # pragma: no cover (compiled)
+    """The exit to the certifier behind ``handle``: whether FCL finds a contact in the hard segments of ``a -> b``."""
+    with objmode(touching="boolean"):
+        touching = _touching(handle, a, b, pairs, spans)
+    return touching
 
 
 @njit(cache=True)
@@ -386,6 +411,9 @@ class _AllFree:
     def hard_segments_free(self, *arguments: Any) -> bool:
         return True
 
+    def hard_segments_touch(self, *arguments: Any) -> bool:
+        return False
+
 
 _EXITS_WARM = [False]
 
@@ -411,3 +439,4 @@ def warm_exits() -> None:
         np.zeros(0, dtype=np.bool_),
     )
     hard_segments_free(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)), 0, 1)
+    hard_segments_touch(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)))

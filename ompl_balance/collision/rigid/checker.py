@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike
 
 from ...core.compiled_calls import entry_point
 from ..advancement import DISTANCE_TOLERANCE
-from ..bisection import bisect_segments
+from ..bisection import bisect_segments, probe_order
 from ..certified import PathCertificate
 from ..checker import WorkCounter
 from ..environment import Environment
@@ -432,9 +432,10 @@ class RigidBodyChecker:
                     exact[pair, t] = found - DISTANCE_TOLERANCE * scale
             return exact[pair, t]
 
-        if not last_valid:  # contacts first: a collision test is cheaper than a distance
-            for pair, t0, t1, _, _ in segments:
-                if distance(int(pair), 0.5 * (t0 + t1)) == -np.inf:
+        if not last_valid and segments:  # contacts first: a collision test is cheaper than a distance
+            middles = np.array([0.5 * (t0 + t1) for _, t0, t1, _, _ in segments])
+            for i in probe_order(middles).tolist():
+                if distance(int(segments[i][0]), float(middles[i])) == -np.inf:
                     return False, 0.0
         parts = len(self._parts)
 
