@@ -261,9 +261,9 @@ def certified_edge_free(
     motion, the configurations evaluated and the distance queries in ``counts``. (The parts of
     a :class:`CertifiedMotions` view it needs, so that Python callers pass no more.)
 
-    Where a non-convex pair's convex parts touch, the advancement stops at once and FCL tests
-    that segment for a contact first (most such edges collide there); only if it finds none
-    is the edge certified in full.
+    Where a non-convex pair's convex parts touch, the advancement stops at the end of that
+    bisection level and FCL tests those segments for a contact first (most such edges collide
+    there); only if it finds none is the edge certified in full.
     """
     counts[Count.MOTIONS] += 1
     start, end = memory_row(memory, a), memory_row(memory, b)
