@@ -67,6 +67,7 @@ from importlib import metadata
 
 import numpy as np
 from cells import medians, ratios, success
+from numba import njit
 from ompl import geometric as og
 from ompl import util as ou
 
@@ -74,9 +75,12 @@ from ompl_balance import BalancedRRTConnect
 from ompl_balance.collision import certified
 from ompl_balance.collision.checker import CollisionChecker
 from ompl_balance.collision.environment import Environment
+from ompl_balance.collision.kernels import certified_motion_free, robot_state_free
 from ompl_balance.collision.robots import load_panda_vamp
+from ompl_balance.core.checks import Count
 from ompl_balance.core.counting import CountingValidityChecker, measured_solve
 from ompl_balance.engine import driver
+from ompl_balance.engine.clock import monotonic_ns
 from ompl_balance.worlds.boxes import BoxWorld2D, Problem, get_problem
 from ompl_balance.worlds.mbm import SCENARIOS, MBMProblem, load_mbm
 from ompl_balance.worlds.rigid import RigidBodyProblem, shipped_robot
@@ -329,9 +333,6 @@ def profile_problem(
 
 def profile(args) -> None:
     """Where the compiled engine's time goes (see the module docstring)."""
-    from numba import njit
-
-    from ompl_balance.collision.kernels import certified_motion_free, robot_state_free
 
     @njit
     def replay(view, starts, ends, states):  # the edges and states of a run, through the kernels
@@ -379,23 +380,22 @@ EDGE_OUTCOMES = {
 }
 
 
+@njit
+def timed_edges(view, starts, ends, free, work, nanoseconds):
+    """Each edge ``starts[i] -> ends[i]`` in order through the certified motion kernel of ``view``:
+    whether it is free, the work it counted and its time (ns, in compiled code). (At module
+    level: compiled as a closure inside its part, it had nanobind report OMPL's objects as
+    leaked when the interpreter exits.)"""
+    for i in range(starts.shape[0]):
+        before = view.counts.copy()
+        began = monotonic_ns()
+        free[i] = certified_motion_free(view, starts[i], ends[i])
+        nanoseconds[i] = monotonic_ns() - began
+        work[i] = view.counts - before
+
+
 def edge_costs(args) -> None:
     """What a certified edge costs by how it ends (see the module docstring)."""
-    from numba import njit
-
-    from ompl_balance.collision.kernels import certified_motion_free
-    from ompl_balance.core.checks import Count
-    from ompl_balance.engine.clock import monotonic_ns
-
-    @njit
-    def replay(view, starts, ends, free, work, nanoseconds):  # a run's edges in order, each timed
-        for i in range(starts.shape[0]):
-            before = view.counts.copy()
-            began = monotonic_ns()
-            free[i] = certified_motion_free(view, starts[i], ends[i])
-            nanoseconds[i] = monotonic_ns() - began
-            work[i] = view.counts - before
-
     robot = load_panda_vamp()
     print(
         f"\nWhat a certified edge costs by how it ends: first {args.problems} problems per scenario, the edges "
@@ -417,8 +417,8 @@ def edge_costs(args) -> None:
             starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
             free, work = np.zeros(len(edges), dtype=np.bool_), np.zeros((len(edges), len(Count)), dtype=np.int64)
             nanoseconds = np.zeros(len(edges), dtype=np.int64)
-            replay(view, starts[:0], ends[:0], free, work, nanoseconds)  # compiled before the timing
-            replay(view, starts, ends, free, work, nanoseconds)
+            timed_edges(view, starts[:0], ends[:0], free, work, nanoseconds)  # compiled before the timing
+            timed_edges(view, starts, ends, free, work, nanoseconds)
             free_parts.append(free)
             work_parts.append(work)
             time_parts.append(nanoseconds)
