@@ -304,6 +304,17 @@ def seeded_solve(robot, problem: MBMProblem, engine: str, seed: int, time_limit:
     return measured_solve(ss, time_limit).time, planner.stats.time
 
 
+def python_engine_checks(robot, problem: MBMProblem, time_limit: float) -> tuple[np.ndarray, np.ndarray, list]:
+    """The edges (their starts and ends, each (edges, dof)) and the states the Python engine's solve
+    of ``problem`` on its seed (``1 + problem.id``) asks the package's checker about: on the same
+    seed the compiled engine makes the same trees, so these are its edges and states too."""
+    with recorded_checks() as (edges, states):
+        seeded_solve(robot, problem, "python", 1 + problem.id, time_limit)
+    starts = np.array([a for a, _ in edges]).reshape(-1, robot.dof)
+    ends = np.array([b for _, b in edges]).reshape(-1, robot.dof)
+    return starts, ends, states
+
+
 def profile_problem(
     robot, problem: MBMProblem, time_limit: float, replay: Callable
 ) -> tuple[float, float, float, float, float, float, int]:
@@ -312,23 +323,20 @@ def profile_problem(
     time in OMPL's checks of the start and goal states, and its edges. The Python engine on the
     same seed makes the same trees, so its validator's calls are the compiled engine's edges and
     states."""
-    seed = 1 + problem.id
-    with recorded_checks() as (edges, states):
-        seeded_solve(robot, problem, "python", seed, time_limit)
+    starts, ends, states = python_engine_checks(robot, problem, time_limit)
     with timed_exits() as spent, timed_slices() as sliced:
-        solve_time, planner_time = seeded_solve(robot, problem, "compiled", seed, time_limit)
+        solve_time, planner_time = seeded_solve(robot, problem, "compiled", 1 + problem.id, time_limit)
     exit_time, endpoint_time, slice_time = spent[0], spent[1], sliced[0]
-    if not edges:
+    if not len(starts):
         return solve_time, planner_time, exit_time, 0.0, slice_time, endpoint_time, 0
     certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))  # (the view's exits)
     view = certifier.compiled_view()
-    starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
     replay(view, starts[:0], ends[:0], np.empty((0, robot.dof)))  # compiled before the timing
     with timed_exits() as spent:
         began = time.perf_counter()
         replay(view, starts, ends, np.array(states).reshape(-1, robot.dof))
         kernel_time = time.perf_counter() - began - spent[0]
-    return solve_time, planner_time, exit_time, kernel_time, slice_time, endpoint_time, len(edges)
+    return solve_time, planner_time, exit_time, kernel_time, slice_time, endpoint_time, len(starts)
 
 
 def profile(args) -> None:
@@ -408,15 +416,13 @@ def edge_costs(args) -> None:
     for scenario in SCENARIOS:
         free_parts, work_parts, time_parts = [], [], []
         for problem in load_mbm(scenario, robot.joint_names)[: args.problems]:
-            with recorded_checks() as (edges, _states):
-                seeded_solve(robot, problem, "python", 1 + problem.id, args.time_limit)
-            if not edges:
+            starts, ends, _states = python_engine_checks(robot, problem, args.time_limit)
+            if not len(starts):
                 continue
             certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))
             view = certifier.compiled_view()  # (its calls out to Python find the certifier while it lives)
-            starts, ends = np.array([a for a, _ in edges]), np.array([b for _, b in edges])
-            free, work = np.zeros(len(edges), dtype=np.bool_), np.zeros((len(edges), len(Count)), dtype=np.int64)
-            nanoseconds = np.zeros(len(edges), dtype=np.int64)
+            free, work = np.zeros(len(starts), dtype=np.bool_), np.zeros((len(starts), len(Count)), dtype=np.int64)
+            nanoseconds = np.zeros(len(starts), dtype=np.int64)
             timed_edges(view, starts[:0], ends[:0], free, work, nanoseconds)  # compiled before the timing
             timed_edges(view, starts, ends, free, work, nanoseconds)
             free_parts.append(free)
@@ -552,12 +558,16 @@ def index(args) -> None:
         grown = size + INDEX_WINDOW
 
 
+#: The script's parts, by the names ``--part`` takes.
+PARTS = {"panda": panda, "2d": two_d, "profile": profile, "edges": edge_costs, "scaling": scaling, "index": index}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--part",
-        default="panda,2d,profile,edges,scaling,index",
-        help="comma-separated parts: panda, 2d, profile, edges, scaling, index",
+        default=",".join(PARTS),
+        help=f"comma-separated parts: {', '.join(PARTS)}",
     )
     parser.add_argument("--problems", type=int, default=25, help="Panda problems per scenario (default 25)")
     parser.add_argument("--runs", type=int, default=1, help="Panda runs per problem and planner (default 1)")
@@ -578,17 +588,8 @@ def main() -> None:
         # Python objects (the Python engine; calls out to Python), by up to 1.5-2x in a full run.
         gc.collect()
         gc.freeze()
-        parts = {
-            "panda": panda,
-            "2d": two_d,
-            "profile": profile,
-            "edges": edge_costs,
-            "scaling": scaling,
-            "index": index,
-        }
-        parts[part](args)
+        PARTS[part](args)
     gc.unfreeze()
-    gc.collect()  # (OMPL objects in cycles freed before the interpreter exits)
     print(f"\nwhole script: {time.perf_counter() - began:.0f} s; median of runs, ratios of medians")
 
 
