@@ -66,6 +66,7 @@ above, so grazing edges end (rejected) after a bounded number of halvings.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -266,13 +267,10 @@ class MotionCertifier:
         ``a -> b``: a collision test at each end whose bound is within the clearance (where the
         pair's convex parts touch), then at each middle; the compiled kernel's exit before it
         certifies the rest of the edge."""
-        delta = b - a
+        poses = self._poses_along(a, b)
         for pair, (t0, t1, d0, d1) in zip(pairs.tolist(), spans.tolist()):
             for t, bound in ((t0, d0), (t1, d1), (0.5 * (t0 + t1), -np.inf)):
-                if bound > self.clearance:
-                    continue
-                self.checker.counter.states_checked += 1
-                if self.checker.pair_touching(pair, self._robot.body_poses(a + t * delta)[0]):
+                if bound <= self.clearance and self.checker.pair_touching(pair, poses(t)):
                     return True
         return False
 
@@ -307,6 +305,19 @@ class MotionCertifier:
             return -np.inf
         return self.checker.pair_distance(pair, poses) - DISTANCE_TOLERANCE
 
+    def _poses_along(self, a: np.ndarray, b: np.ndarray) -> Callable[[float], np.ndarray]:
+        """The body poses at fraction ``t`` of the edge ``a -> b``: ``poses(t)``, each worked out
+        (and counted as a state checked) once."""
+        delta, poses_at = b - a, {}
+
+        def poses(t: float) -> np.ndarray:
+            if t not in poses_at:
+                poses_at[t] = self._robot.body_poses(a + t * delta)[0]
+                self.checker.counter.states_checked += 1
+            return poses_at[t]
+
+        return poses
+
     def _known(self, row: int) -> dict[int, float]:
         """The FCL distances remembered at end-memory ``row`` (forgotten when the row is reused)."""
         generation = int(self._memory.generation[row])
@@ -334,15 +345,8 @@ class MotionCertifier:
         ``last_valid`` it returns at the first failure. Segments reaching a failure are
         refined to ``settle`` metres of travel only.
         """
-        clearance, speed, delta = self.clearance, self._scratch.speed, b - a
-        poses_at: dict[float, np.ndarray] = {}
+        clearance, speed, poses = self.clearance, self._scratch.speed, self._poses_along(a, b)
         exact: dict[tuple[int, float], float] = {}
-
-        def poses(t: float) -> np.ndarray:
-            if t not in poses_at:
-                poses_at[t] = self._robot.body_poses(a + t * delta)[0]
-                self.checker.counter.states_checked += 1
-            return poses_at[t]
 
         def distance(pair: int, t: float) -> float:
             known = self._known(start) if t == 0.0 else self._known(end) if t == 1.0 else None

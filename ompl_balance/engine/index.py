@@ -219,8 +219,8 @@ def _key(
 ) -> float:  # pragma: no cover (compiled)
     """What nodes are compared by: the squared distance (Euclidean spaces, as the scan compares)
     or the distance, computed in full only when the position's share alone (coordinates
-    ``offset .. offset + axes``, weight ``weight``) is not above ``best``. (Scalars rather
-    than the index: passing its arrays costs more, per node, than the distance.)"""
+    ``offset .. offset + axes``, weight ``weight``) is not above ``best`` (``inf`` when it is).
+    (Scalars rather than the index: passing its arrays costs more, per node, than the distance.)"""
     if euclidean:
         squared = 0.0
         for k in range(query.shape[0]):
@@ -231,8 +231,10 @@ def _key(
     for k in range(offset, offset + axes):
         gap = states[node, k] - query[k]
         squared += gap * gap
-    share = weight * np.sqrt(squared)
-    return share if share > best else row_distance(layout, states, node, query)
+    # (the share is above ``best`` where its square is by more than rounding: no root taken)
+    if squared * (weight * weight) > best * best * (1.0 + 1e-9):
+        return np.inf
+    return row_distance(layout, states, node, query)
 
 
 @njit(cache=True, inline="always")
@@ -246,10 +248,11 @@ def _scan(
     offset: int,
     axes: int,
     weight: float,
+    best: int,
+    best_key: float,
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
-    """The node of ``lo .. hi - 1`` nearest ``query`` (the first on ties) and its key
-    (:func:`_key`); ``(-1, inf)`` for none."""
-    best, best_key = NONE, np.inf
+    """The nearest to ``query`` of node ``best`` (key ``best_key``; -1, ``inf``: none) and the
+    nodes ``lo .. hi - 1``, all numbered above it (the first on ties), and its key (:func:`_key`)."""
     for node in range(lo, hi):
         key = _key(layout, euclidean, states, node, query, offset, axes, weight, best_key)
         if key < best_key:
@@ -366,31 +369,40 @@ def indexed_nearest(
 
 
 @njit(cache=True, inline="always")
-def _squared_gaps(
-    low: np.ndarray, high: np.ndarray, row: int, at: np.ndarray, position_axes: int, axes: int
-) -> tuple[float, float]:  # pragma: no cover (compiled)
-    """The squared distances (position, rotation) from index coordinates ``at`` (axes,) to the
-    box ``low[row] .. high[row]`` (a point when ``low`` and ``high`` are one array)."""
-    position_squared = rotation_squared = 0.0
-    for k in range(axes):
+def _box_gap(
+    low: np.ndarray, high: np.ndarray, row: int, at: np.ndarray, first: int, last: int
+) -> float:  # pragma: no cover (compiled)
+    """The squared distance from index coordinates ``at`` (axes,) to the box ``low[row] ..
+    high[row]`` over axes ``first .. last - 1``."""
+    squared = 0.0
+    for k in range(first, last):
         gap = max(low[row, k] - at[k], at[k] - high[row, k], 0.0)
-        if k < position_axes:
-            position_squared += gap * gap
-        else:
-            rotation_squared += gap * gap
-    return position_squared, rotation_squared
+        squared += gap * gap
+    return squared
+
+
+@njit(cache=True, inline="always")
+def _point_gap(points: np.ndarray, row: int, at: np.ndarray, first: int, last: int) -> float:  # pragma: no cover
+    """The squared distance from index coordinates ``at`` (axes,) to ``points[row]`` over axes
+    ``first .. last - 1``."""
+    squared = 0.0
+    for k in range(first, last):
+        gap = points[row, k] - at[k]
+        squared += gap * gap
+    return squared
 
 
 @njit(cache=True, inline="always")
 def _search(
     index: KDIndex, layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray, euclidean: bool
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
-    """The nearest node of ``states[:size]`` and its key (:func:`_key`): the nodes added since
-    the last build scanned, then each block's k-d tree descended (the largest first)."""
+    """The nearest node of ``states[:size]`` and its key (:func:`_key`): each block's k-d tree
+    descended (the largest first), then the nodes added since the last build scanned. Boxes and
+    nodes are tested on their position's share alone first, which decides most of them."""
     ints = index.ints
     axes, built = ints[Setting.AXES], ints[Setting.BUILT]
     weight, position, position_axes = index.weight, ints[Setting.POSITION], ints[Setting.POSITION_AXES]
-    best, best_key = _scan(layout, euclidean, states, built, size, query, position, position_axes, weight[0])
+    best, best_key = NONE, np.inf
     at = index.query
     rotations = _index_coordinates(index, query, at) and ints[Setting.UNIT_ROTATIONS] == 1
     order, points, stack, low, high = index.order, index.points, index.stack, index.low, index.high
@@ -406,13 +418,20 @@ def _search(
         depth -= 1
         lo, hi = stack[depth, 0], stack[depth, 1]
         middle = (lo + hi) // 2
-        position_squared, rotation_squared = _squared_gaps(low, high, middle, at, position_axes, axes)
+        # every node of the subtree farther than the best: skipped (ties are looked at)
+        position_squared = _box_gap(low, high, middle, at, 0, position_axes)
+        if _bound(euclidean, position_squared, 0.0, weight, False) > best_key:
+            continue
+        rotation_squared = _box_gap(low, high, middle, at, position_axes, axes)
         if _bound(euclidean, position_squared, rotation_squared, weight, rotations) > best_key:
-            continue  # every node of the subtree is farther than the best (ties are looked at)
+            continue
         # a leaf's nodes, or the splitting node of a larger subtree
         first, last = (lo, hi) if hi - lo <= LEAF else (middle, middle + 1)
         for row in range(first, last):
-            position_squared, rotation_squared = _squared_gaps(points, points, row, at, position_axes, axes)
+            position_squared = _point_gap(points, row, at, 0, position_axes)
+            if _bound(euclidean, position_squared, 0.0, weight, False) > best_key:
+                continue
+            rotation_squared = _point_gap(points, row, at, position_axes, axes)
             if _bound(euclidean, position_squared, rotation_squared, weight, rotations) <= best_key:
                 node = order[row]
                 key = _key(layout, euclidean, states, node, query, position, position_axes, weight[0], best_key)
@@ -428,4 +447,5 @@ def _search(
             stack[depth, 0], stack[depth, 1] = lo, middle
             stack[depth + 1, 0], stack[depth + 1, 1] = middle + 1, hi
         depth += 2
-    return best, best_key
+    # the nodes added since the last build last, the best found being close: most fail on their position
+    return _scan(layout, euclidean, states, built, size, query, position, position_axes, weight[0], best, best_key)
