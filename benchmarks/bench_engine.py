@@ -40,8 +40,11 @@ the engines' speed alone.
 ``scaling``
     The cost of an iteration as the trees grow to tens of thousands of nodes, in R^2 and SE(3)
     (a box world and a rigid body, each cut in two by a wall so that both trees grow freely
-    and never meet): solves of increasing length on one seed, each repeating the shorter ones,
-    so the difference of two is the cost of the iterations between them.
+    and never meet): a solve on one seed, run three times, timed at the end of each compiled
+    slice (a few milliseconds). The runs make the same trees iteration for iteration, so the
+    times of a window of iterations differ by the machine only. Per run, the ratio of the most
+    to the least cost per iteration over the windows from 100 to 20,000 nodes (the machine's
+    speed drifts more between runs than within one), and their median.
 
 ``index``
     The nearest-node index alone: a tree of uniform SE(3) states in an 8 m cube grown to 20,000
@@ -64,6 +67,7 @@ import platform
 import time
 from collections.abc import Callable, Iterator
 from importlib import metadata
+from typing import NamedTuple
 
 import numpy as np
 from cells import medians, ratios, success
@@ -81,6 +85,7 @@ from ompl_balance.core.checks import Count
 from ompl_balance.core.counting import CountingValidityChecker, measured_solve
 from ompl_balance.engine import driver
 from ompl_balance.engine.clock import monotonic_ns
+from ompl_balance.engine.loop import Slot
 from ompl_balance.worlds.boxes import BoxWorld2D, Problem, get_problem
 from ompl_balance.worlds.mbm import SCENARIOS, MBMProblem, load_mbm
 from ompl_balance.worlds.rigid import RigidBodyProblem, shipped_robot
@@ -240,11 +245,8 @@ def timed_exits() -> Iterator[list[float]]:
     calls out to Python count there only."""
     spent = [0.0, 0.0]
     inside_is_valid = [False]
-    decide, hard, is_valid = (
-        CollisionChecker.decide,
-        certified.MotionCertifier.hard_segments_free,
-        CollisionChecker.is_valid,
-    )
+    decide, is_valid = CollisionChecker.decide, CollisionChecker.is_valid
+    hard_free, hard_touch = certified.MotionCertifier.hard_segments_free, certified.MotionCertifier.hard_segments_touch
 
     def timed(function, slot):
         def wrapper(*arguments, **keywords):
@@ -260,36 +262,51 @@ def timed_exits() -> Iterator[list[float]]:
 
         return wrapper
 
-    CollisionChecker.decide, certified.MotionCertifier.hard_segments_free = timed(decide, 0), timed(hard, 0)
-    CollisionChecker.is_valid = timed(is_valid, 1)
+    CollisionChecker.decide, CollisionChecker.is_valid = timed(decide, 0), timed(is_valid, 1)
+    certified.MotionCertifier.hard_segments_free = timed(hard_free, 0)
+    certified.MotionCertifier.hard_segments_touch = timed(hard_touch, 0)
     try:
         yield spent
     finally:
-        CollisionChecker.decide, certified.MotionCertifier.hard_segments_free = decide, hard
-        CollisionChecker.is_valid = is_valid
+        CollisionChecker.decide, CollisionChecker.is_valid = decide, is_valid
+        certified.MotionCertifier.hard_segments_free = hard_free
+        certified.MotionCertifier.hard_segments_touch = hard_touch
+
+
+class SliceEnd(NamedTuple):
+    """A compiled slice as it ended: when it began and ended (``time.perf_counter()``, s), and the
+    solve's iterations and nodes in both trees then."""
+
+    began: float
+    ended: float
+    iterations: int
+    nodes: int
 
 
 @contextlib.contextmanager
-def timed_slices() -> Iterator[list[float]]:
-    """Seconds spent inside the compiled loop's slices (kernels and exits included) while inside, in ``[0]``."""
-    spent = [0.0]
+def traced_slices() -> Iterator[list[SliceEnd]]:
+    """The compiled loop's slices (kernels and exits included) run while inside, in order."""
+    trace: list[SliceEnd] = []
     runner = driver._runner
 
-    def timed_runner(*arguments):
+    def traced_runner(*arguments):
         run_slice = runner(*arguments)
 
-        def timed(*slice_arguments):
+        def traced(*slice_arguments):
             began = time.perf_counter()
             try:
                 return run_slice(*slice_arguments)
             finally:
-                spent[0] += time.perf_counter() - began
+                ended, loop_arrays = time.perf_counter(), slice_arguments[4]
+                trace.append(
+                    SliceEnd(began, ended, int(loop_arrays.ints[Slot.ITERATIONS]), int(loop_arrays.sizes.sum()))
+                )
 
-        return timed
+        return traced
 
-    driver._runner = timed_runner
+    driver._runner = traced_runner
     try:
-        yield spent
+        yield trace
     finally:
         driver._runner = runner
 
@@ -324,9 +341,9 @@ def profile_problem(
     same seed makes the same trees, so its validator's calls are the compiled engine's edges and
     states."""
     starts, ends, states = python_engine_checks(robot, problem, time_limit)
-    with timed_exits() as spent, timed_slices() as sliced:
+    with timed_exits() as spent, traced_slices() as trace:
         solve_time, planner_time = seeded_solve(robot, problem, "compiled", 1 + problem.id, time_limit)
-    exit_time, endpoint_time, slice_time = spent[0], spent[1], sliced[0]
+    exit_time, endpoint_time, slice_time = spent[0], spent[1], sum(end.ended - end.began for end in trace)
     if not len(starts):
         return solve_time, planner_time, exit_time, 0.0, slice_time, endpoint_time, 0
     certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))  # (the view's exits)
@@ -459,36 +476,59 @@ def split_room() -> Callable[[], og.SimpleSetup]:
     return problem.simple_setup
 
 
-#: Solve lengths (s) of the scaling part: the same seed each time, so each solve repeats the shorter ones.
-SCALING_LIMITS = (0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 4.0)
+#: The scaling part's solves: per problem a time limit (s) that grows the trees past 20,000
+#: nodes, run this many times on one seed (the same iterations each run, only their times differ).
+SCALING_RUNS = 3
+#: The tree sizes (nodes in both trees) between which the scaling part reports the cost of an iteration.
+SCALING_WINDOWS = (100, 200, 500, 1_000, 2_000, 5_000, 10_000, 20_000)
 
 
 def scaling(args) -> None:
     """The cost of an iteration as the trees grow (see the module docstring)."""
-    print("\nCost of an iteration as the trees grow (BalancedRRTConnect, compiled engine, one seed)\n")
     print(
-        "| problem | nodes (both trees) | iterations | us / iteration between the two | states checked / iteration |"
-        "\n|---|---|---|---|---|"
+        f"\nCost of an iteration as the trees grow (BalancedRRTConnect, compiled engine, one seed, "
+        f"{SCALING_RUNS} runs)\n\n| problem | nodes (both trees) | iterations | us / iteration, median of the runs "
+        "| us / iteration, each run |\n|---|---|---|---|---|"
     )
-    for label, make_setup in (("R^2, a wall across", split_box_world()), ("SE(3), a wall across", split_room())):
-        previous, costs = (0, 0, 0.0, 0), []  # (iterations, nodes, seconds, checks) of the solve before
-        for limit in SCALING_LIMITS:
+    cases = (("R^2, a wall across", split_box_world(), 1.0), ("SE(3), a wall across", split_room(), 4.0))
+    for label, make_setup, time_limit in cases:
+        traces, checks = [], []
+        for _ in range(SCALING_RUNS):
             ss = make_setup()
             planner = BalancedRRTConnect(ss.getSpaceInformation())
             planner.setEngine("compiled")
             planner.setSeed(7)
             ss.setPlanner(planner)
-            run = measured_solve(ss, limit)
-            elapsed, checks = run.time, run.work.states_checked
-            iterations, nodes = planner.stats.iterations, planner.stats.start_tree_size + planner.stats.goal_tree_size
-            cost = (elapsed - previous[2]) / max(iterations - previous[0], 1) * 1e6
-            checks_each = (checks - previous[3]) / max(iterations - previous[0], 1)
-            if previous[1] >= 100 and nodes <= 20_000:  # (the first solve's cost includes the solve's own)
-                costs.append(cost)
-            print(f"| {label} | {previous[1]} to {nodes} | {iterations} | {cost:.1f} | {checks_each:.1f} |", flush=True)
-            previous = (iterations, nodes, elapsed, checks)
-        if costs:
-            print(f"| {label} | 100 to 20,000: most / least cost per iteration | | {max(costs) / min(costs):.2f} | |")
+            with traced_slices() as trace:
+                run = measured_solve(ss, time_limit)
+            traces.append(trace)
+            checks.append(run.work.states_checked / max(planner.stats.iterations, 1))
+        reached = traces[0][-1].nodes
+        if reached < SCALING_WINDOWS[-1]:
+            print(f"| {label} | {reached:,} nodes in {time_limit:g} s: fewer than {SCALING_WINDOWS[-1]:,} | | | |")
+            continue
+        # Each run makes the same trees: the iteration at which they hold a window's end is found on
+        # the first run's slice ends, and each run's time at it, between its own slice ends.
+        first = traces[0]
+        at = np.interp(SCALING_WINDOWS, [0] + [end.nodes for end in first], [0] + [end.iterations for end in first])
+        costs = np.empty((len(SCALING_WINDOWS) - 1, SCALING_RUNS))  # us per iteration, by window and run
+        for r, trace in enumerate(traces):
+            times = np.interp(
+                at, [0] + [end.iterations for end in trace], [trace[0].began] + [end.ended for end in trace]
+            )
+            costs[:, r] = np.diff(times) / np.diff(at) * 1e6
+        for j, each in enumerate(costs):
+            print(
+                f"| {label} | {SCALING_WINDOWS[j]:,} to {SCALING_WINDOWS[j + 1]:,} | {at[j + 1] - at[j]:.0f} "
+                f"| {np.median(each):.1f} | {', '.join(f'{c:.1f}' for c in each)} |",
+                flush=True,
+            )
+        spread = costs.max(axis=0) / costs.min(axis=0)  # each run's own: the machine's speed drifts between runs
+        print(
+            f"| {label} | {SCALING_WINDOWS[0]:,} to {SCALING_WINDOWS[-1]:,}: most / least cost per iteration "
+            f"| | median {np.median(spread):.2f} | {', '.join(f'{x:.2f}' for x in spread)} "
+            f"(states checked per iteration: {np.mean(checks):.1f}) |"
+        )
 
 
 #: Tree sizes at which the index part times its queries (each over the next INDEX_WINDOW sizes).
