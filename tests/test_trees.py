@@ -86,6 +86,24 @@ def test_kernels_load_only_where_a_tree_needs_them():
     ]
 
 
+def test_small_trees_scan_with_the_kernels_once_the_compiled_engine_imported_them():
+    """Where the compiled engine has imported the compiled scans, a tree of a few nodes scans
+    with them at once (nothing loaded in the background), with the answer numpy gave."""
+    script = (
+        "import numpy as np\n"
+        "from ompl_balance.core import trees\n"
+        "tree = trees.ArrayTree(2)\n"
+        "for point in np.random.default_rng(0).random((50, 2)):\n"
+        "    tree.add(point)\n"
+        "query = np.array([0.3, 0.6])\n"
+        "answer = tree.nearest(query)\n"
+        "print(trees._LOADER.scans is None)\n"
+        "import ompl_balance.engine.loop\n"  # (what loading the compiled engine imports)
+        "print(tree.nearest(query) == answer, trees._LOADER.scans is not None, trees._LOADER.thread is None)\n"
+    )
+    assert run_with_seed(script, 0).split() == ["True"] * 4
+
+
 @pytest.mark.parametrize("dim", range(1, 10))
 def test_numpy_and_compiled_scans_agree_to_the_last_bit(dim):
     rng = np.random.default_rng(dim)
