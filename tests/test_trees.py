@@ -86,22 +86,32 @@ def test_kernels_load_only_where_a_tree_needs_them():
     ]
 
 
-def test_small_trees_scan_with_the_kernels_once_the_compiled_engine_imported_them():
-    """Where the compiled engine has imported the compiled scans, a tree of a few nodes scans
-    with them at once (nothing loaded in the background), with the answer numpy gave."""
+def test_small_euclidean_trees_scan_with_the_kernels_once_the_compiled_engine_imported_them():
+    """Where the compiled engine has imported the compiled scans, a Euclidean tree of a few nodes
+    scans with them at once (nothing loaded in the background; numpy's scan is not called), with
+    the answer numpy gave; an SE(2) tree as small keeps numpy's scan (its kernel compiles at its
+    first call, which a short solve must not wait for)."""
     script = (
         "import numpy as np\n"
+        "from ompl import base as ob\n"
         "from ompl_balance.core import trees\n"
-        "tree = trees.ArrayTree(2)\n"
-        "for point in np.random.default_rng(0).random((50, 2)):\n"
-        "    tree.add(point)\n"
+        "from ompl_balance.core.layout import layout_for\n"
+        "rng = np.random.default_rng(0)\n"
+        "tree, plane = trees.ArrayTree(2), trees.ArrayTree(3, layout=layout_for(ob.SE2StateSpace()))\n"
+        "for point in rng.random((50, 3)):\n"
+        "    tree.add(point[:2])\n"
+        "    plane.add(point)\n"
         "query = np.array([0.3, 0.6])\n"
         "answer = tree.nearest(query)\n"
-        "print(trees._LOADER.scans is None)\n"
         "import ompl_balance.engine.loop\n"  # (what loading the compiled engine imports)
-        "print(tree.nearest(query) == answer, trees._LOADER.scans is not None, trees._LOADER.thread is None)\n"
+        "trees.squared_distances = trees.distances = None\n"  # (numpy's scans: a call fails)
+        "print(tree.nearest(query) == answer, trees._LOADER.thread is None)\n"
+        "try:\n"
+        "    plane.nearest(np.array([0.3, 0.6, 0.5]))\n"
+        "except TypeError:\n"
+        "    print('numpy')\n"
     )
-    assert run_with_seed(script, 0).split() == ["True"] * 4
+    assert run_with_seed(script, 0).split() == ["True", "True", "numpy"]
 
 
 @pytest.mark.parametrize("dim", range(1, 10))

@@ -7,9 +7,9 @@ Two stores with one interface (:class:`Tree`), chosen by :mod:`ompl_balance.core
     SE(3) and compounds of them) in one contiguous ``(capacity, dim)`` float64 array grown
     by doubling; nearest and near neighbours by a scan of all nodes (exact): numpy while
     the process's trees are small, the compiled kernels of :mod:`ompl_balance.core.compiled_spaces`
-    once they are in the process: imported by the compiled engine, or loaded in a background
-    thread once a tree has reached :data:`COMPILED_SCANS_FROM` nodes (so that no solve waits
-    for numba); the same answers either way.
+    once a tree has reached :data:`COMPILED_SCANS_FROM` nodes and they have loaded in a
+    background thread (so that no solve waits for numba), or, for Euclidean trees, once the
+    compiled engine has imported them; the same answers either way.
 :class:`StateTree`
     OMPL states of any space in a list; nearest neighbour by ``si.distance`` over all
     nodes (exact, slower: one call into OMPL per node).
@@ -131,8 +131,9 @@ class _Links:
 
 
 #: Tree size at which an :class:`ArrayTree` starts loading the compiled kernels in the
-#: background; until they are in the process, every tree scans with numpy, afterwards every
-#: tree with the kernels (``benchmarks/bench_rrtc.py --scans`` measures the trade-off).
+#: background; until they are loaded, every tree scans with numpy (a Euclidean one only until
+#: the compiled engine imports them), afterwards every tree with the kernels
+#: (``benchmarks/bench_rrtc.py --scans`` measures the trade-off).
 COMPILED_SCANS_FROM = 1024
 
 
@@ -151,20 +152,23 @@ class _ScanLoader:
         return compiled_spaces
 
     def loaded(self) -> ModuleType | None:
-        if self.scans is None and self.thread is None and self.imported() is None:
+        if self.scans is None and self.thread is None:
+            if self.imported() is not None:
+                return self.load()
             # (or being imported, e.g. by the compiled engine's loader: waiting for that
             # import here would stall a solve, so the background thread does)
             self.thread = threading.Thread(target=self.load, name="ompl_balance-load-scans")
             self.thread.start()
         return self.scans
 
-    def imported(self) -> ModuleType | None:
+    @staticmethod
+    def imported() -> ModuleType | None:
         """The compiled scans where something else has imported them already (the compiled
         engine, a forkserver's preload), else ``None``; loads nothing."""
         module = sys.modules.get("ompl_balance.core.compiled_spaces")
         if module is None or getattr(module.__spec__, "_initializing", False):
             return None
-        return self.load()
+        return module
 
     def finish(self) -> None:
         """Wait for a background load (a process must not fork in the middle of an import)."""
@@ -204,10 +208,10 @@ class ArrayTree(_Links):
     (:mod:`ompl_balance.core.layout`; ``None``: Euclidean).
 
     Nearest and near queries scan all nodes (exact): with numpy until the compiled kernels
-    are in the process (the compiled engine imports them; a tree of :data:`COMPILED_SCANS_FROM`
-    nodes starts their loading), then in one compiled loop (for the tree sizes sampling
-    planners reach, faster than any index would be from Python). For real-vector states both
-    scans return the same answers to the last bit.
+    are loaded (a tree of :data:`COMPILED_SCANS_FROM` nodes starts their loading; a Euclidean
+    tree takes them as soon as the compiled engine has imported them), then in one compiled
+    loop (for the tree sizes sampling planners reach, faster than any index would be from
+    Python). For real-vector states both scans return the same answers to the last bit.
     """
 
     def __init__(self, dim: int, capacity: int = 1024, layout: SpaceLayout | None = None) -> None:
@@ -259,13 +263,17 @@ class ArrayTree(_Links):
         self._near_distances = np.empty(capacity)
 
     def _compiled(self) -> ModuleType | None:
-        """The compiled scans where they are in the process, whatever the tree's size: imported
-        by the compiled engine, or loaded in the background, which a tree reaching
-        :data:`COMPILED_SCANS_FROM` nodes starts (a call costs about 1 us against numpy's 4-6 us
-        at a few hundred nodes)."""
+        """The compiled scans once loaded, whatever the tree's size (their loading starts when a
+        tree first reaches :data:`COMPILED_SCANS_FROM` nodes), and for a Euclidean tree as soon
+        as the compiled engine has imported them: their Euclidean scans are compiled at import,
+        so nothing waits for numba (a call costs about 1 us against numpy's 4-6 us at a few
+        hundred nodes; another metric's scan compiles at its first call)."""
         scans = _LOADER.scans
         if scans is None:
-            scans = compiled_scans() if self.size >= COMPILED_SCANS_FROM else _LOADER.imported()
+            if self.size >= COMPILED_SCANS_FROM:
+                scans = compiled_scans()
+            elif self._layout is None:
+                scans = _LOADER.imported()
         return scans
 
     def nearest(self, state: np.ndarray) -> tuple[int, float]:
