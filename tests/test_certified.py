@@ -361,6 +361,26 @@ def test_probe_order_visits_every_segment_coarse_to_fine():
             assert gaps.max() - 1 <= int(np.ceil(n / 2**j)), (n, j, probed)
 
 
+def test_contacts_at_middles_are_looked_for_in_probe_order_up_to_the_first():
+    """The midpoints are tested in :func:`probe_order`'s order and the search stops at the first
+    contact; without one every midpoint is tested once."""
+    from ompl_balance.collision.bisection import contact_at_middles, probe_order
+
+    middles = np.random.default_rng(5).random(21)
+    order = probe_order(middles).tolist()
+    for contact in (order[0], order[7], order[-1], None):
+        tested: list[tuple[int, float]] = []
+
+        def touching(i: int, t: float) -> bool:
+            tested.append((i, t))
+            return i == contact
+
+        assert contact_at_middles(middles, touching) == (contact is not None)
+        stop = len(order) if contact is None else order.index(contact) + 1
+        assert tested == [(i, float(middles[i])) for i in order[:stop]]
+    assert not contact_at_middles(np.empty(0), touching)
+
+
 # ---------------------------------------------------------------------------------------- work, clearance, input
 
 

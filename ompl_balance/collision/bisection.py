@@ -55,6 +55,12 @@ def _bit_reversed(bits: int) -> np.ndarray:
     return ranks
 
 
+def contact_at_middles(middles: np.ndarray, touching: Callable[[int, float], bool]) -> bool:
+    """Whether ``touching(i, middles[i])`` finds a contact at the midpoint of one of the segments
+    (midpoints ``middles`` (n,)), tested in :func:`probe_order` and stopping at the first."""
+    return any(touching(i, float(middles[i])) for i in probe_order(middles).tolist())
+
+
 def sharper(bound: float, exact: float) -> float:
     """The better of a lower bound and an exact distance (``-inf``: contact, which stands)."""
     return exact if exact == -np.inf else max(bound, exact)

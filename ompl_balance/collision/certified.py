@@ -85,7 +85,7 @@ from .advancement import (
     memory_row,
     sphere_bounds,
 )
-from .bisection import bisect_segments, probe_order
+from .bisection import bisect_segments, contact_at_middles
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
 from .kernels import CertifiedMotions, certified_edge_free, robot_states
@@ -358,11 +358,11 @@ class MotionCertifier:
                     known[pair] = exact[pair, t]
             return exact[pair, t]
 
-        if not last_valid:  # contacts first: an FCL collision test costs a few microseconds
-            middles = 0.5 * (spans[:, 0] + spans[:, 1])
-            for i in probe_order(middles).tolist():
-                if self.checker.pair_touching(int(pairs[i]), poses(float(middles[i]))):
-                    return True, 0.0
+        # contacts first: an FCL collision test costs a few microseconds, a distance far more
+        if not last_valid and contact_at_middles(
+            0.5 * (spans[:, 0] + spans[:, 1]), lambda i, t: self.checker.pair_touching(int(pairs[i]), poses(t))
+        ):
+            return True, 0.0
         segments = [(pair, t0, t1, d0, d1) for pair, (t0, t1, d0, d1) in zip(pairs.tolist(), spans.tolist())]
         return bisect_segments(
             segments,

@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike
 
 from ...core.compiled_calls import entry_point
 from ..advancement import DISTANCE_TOLERANCE
-from ..bisection import bisect_segments, probe_order
+from ..bisection import bisect_segments, contact_at_middles
 from ..certified import PathCertificate
 from ..checker import WorkCounter
 from ..environment import Environment
@@ -401,6 +401,7 @@ class RigidBodyChecker:
         settle = (LAST_VALID_TRAVEL if last_valid else MIN_TRAVEL) * scale
         poses: dict[float, np.ndarray] = {}
         exact: dict[tuple[int, float], float] = {}
+        touches: dict[tuple[int, float], bool] = {}
         state = np.empty(len(a))
         whole_body, whole_world = self._whole_body, self._whole_world
         if whole_body is not None and whole_world is not None and segments:
@@ -414,29 +415,37 @@ class RigidBodyChecker:
                 counter.states_checked += 1
             return poses[t]
 
+        def placed(pair: int, t: float) -> tuple[fcl.CollisionObject, fcl.CollisionObject]:
+            """The pair's FCL objects with the body at ``t``."""
+            if pair == WHOLE and whole_body is not None and whole_world is not None:
+                pose = pose_at(t)
+                whole_body.setRotation(pose[:3, :3])
+                whole_body.setTranslation(pose[:3, 3])
+                return whole_body, whole_world
+            self._place(pose_at(t), pair % len(self._parts))
+            return self._pair_objects(pair)
+
+        def touching(pair: int, t: float) -> bool:
+            if (pair, t) not in touches:
+                touches[pair, t] = fcl.collide(*placed(pair, t), _REQUEST, fcl.CollisionResult())
+            return touches[pair, t]
+
         def distance(pair: int, t: float) -> float:
             if (pair, t) not in exact:
-                if pair == WHOLE and whole_body is not None and whole_world is not None:
-                    first, second = whole_body, whole_world
-                    pose = pose_at(t)
-                    first.setRotation(pose[:3, :3])
-                    first.setTranslation(pose[:3, 3])
-                else:
-                    first, second = self._pair_objects(pair)
-                    self._place(pose_at(t), pair % len(self._parts))
-                if fcl.collide(first, second, _REQUEST, fcl.CollisionResult()):
+                if touching(pair, t):
                     exact[pair, t] = -np.inf
                 else:
                     counter.distance_queries += 1
-                    found = fcl.distance(first, second, _DISTANCE_REQUEST, fcl.DistanceResult())
+                    found = fcl.distance(*placed(pair, t), _DISTANCE_REQUEST, fcl.DistanceResult())
                     exact[pair, t] = found - DISTANCE_TOLERANCE * scale
             return exact[pair, t]
 
-        if not last_valid and segments:  # contacts first: a collision test is cheaper than a distance
-            middles = np.array([0.5 * (t0 + t1) for _, t0, t1, _, _ in segments])
-            for i in probe_order(middles).tolist():
-                if distance(int(segments[i][0]), float(middles[i])) == -np.inf:
-                    return False, 0.0
+        # contacts first: a collision test is cheaper than a distance, which a segment its ends
+        # certify never needs at its middle
+        if not last_valid and contact_at_middles(
+            np.array([0.5 * (t0 + t1) for _, t0, t1, _, _ in segments]), lambda i, t: touching(int(segments[i][0]), t)
+        ):
+            return False, 0.0
         parts = len(self._parts)
 
         def group(pair: int) -> int:  # the body part of a pair (WHOLE: the whole body)
