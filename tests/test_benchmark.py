@@ -300,6 +300,26 @@ def test_a_sampler_never_begun_ends_with_its_block():
     assert not sampler._thread.is_alive() and sampler.samples == []
 
 
+def test_a_sweep_tells_the_user_nothing_about_seeds_it_sets_correctly(tmp_path):
+    """Each run seeds OMPL in a process forked from the forkserver, whose warm-up has already
+    drawn seeds; OMPL would log an error per run that the seed cannot make it deterministic,
+    which it does (the runs repeat: test_a_run_re_executed_alone_repeats_its_result). Run as a
+    user runs it, the sweep's standard error says nothing of it."""
+    path = write(tmp_path, GOOD.replace("runs = 2", "runs = 1"))
+    result = subprocess.run(
+        [sys.executable, "-m", "ompl_balance.cli", "bench", str(path), "-o", str(tmp_path / "out"), "--no-progress"],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=REPO,
+    )
+    assert result.returncode == 0, result.stderr
+    records = [json.loads(line) for line in (tmp_path / "out" / "results.jsonl").read_text().splitlines()]
+    assert sorted(r["planner"] for r in records) == ["Balanced r=0.5", "RRTConnect"]
+    assert "Random number generation already started" not in result.stderr + result.stdout
+
+
 def test_rerun_runs_nothing_and_more_runs_add_only_the_missing(tmp_path):
     experiment = small()
     first = bench(experiment, tmp_path, progress=False)

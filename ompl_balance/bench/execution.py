@@ -130,6 +130,24 @@ def warm_up(task: RunTask) -> None:
     ss.solve(ptc)
 
 
+def _seed_ompl(seed: int) -> None:
+    """Seed OMPL's seed generator, from which every random generator made after this call (the
+    run's problem, planner and samplers) takes its own seed.
+
+    In a run forked from a sweep's forkserver the generator has already handed out seeds, to
+    what the forkserver's warm-up made (which no run uses), so OMPL logs an error that changing
+    the seed now will not be deterministic. It reseeds the generator all the same, and for the
+    run it is: its runs repeat their results (the benchmark's tests). That message, one per run,
+    is not shown.
+    """
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LogLevel.LOG_NONE)
+    try:
+        ou.RNG.setSeed(seed)
+    finally:
+        ou.setLogLevel(level)
+
+
 def _no_phase(phase: str) -> None:
     """The default phase report of :func:`execute`: none."""
 
@@ -148,7 +166,7 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
     The planner's progress properties, sampled every 0.05 s during the solve, go to the
     record's ``progress``. A solve that raises is recorded with OMPL's ``CRASH`` status.
     """
-    ou.RNG.setSeed(task.seed)  # before anything draws a random number in this process
+    _seed_ompl(task.seed)  # before this run makes anything that draws random numbers
     ss = task.problem.build()
     si = ss.getSpaceInformation()
     planner = task.planner.build(si)

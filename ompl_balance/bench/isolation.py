@@ -2,9 +2,10 @@
 
 Every run executes in a fresh process forked from a ``forkserver`` that has imported OMPL
 and this package once (a few milliseconds per run, not a new interpreter). The fresh
-process matters twice: OMPL's global ``RNG.setSeed`` only works before the first random
-number of a process, so each run seeds it with its own seed
-(:func:`~ompl_balance.bench.experiment.run_seed`) and stock planners repeat too; and a run
+process matters twice: OMPL's global ``RNG.setSeed`` seeds only the random generators made
+after it, so each run seeds it with its own seed
+(:func:`~ompl_balance.bench.experiment.run_seed`) before it builds anything, and stock
+planners repeat too, their generators made in the run's process alone; and a run
 that segfaults, aborts or ignores its time limit takes only its own process down. The
 parent waits at most ``task.hard_limit`` seconds (2 x the time limit + a margin: planning,
 then simplification bounded by the time limit) and records OMPL's ``CRASH`` status for a
