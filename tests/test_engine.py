@@ -495,8 +495,10 @@ def test_ctrl_c_interrupts_a_compiled_solve(checker):
     an exit to Python (SIGINT only sets a flag while a slice runs)."""
     script = textwrap.dedent(
         f"""
-        import sys
+        import signal, sys
         from ompl import util as ou
+        # Python's handler, as an interactive program has (a background job starts ignoring SIGINT)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         ou.setLogLevel(ou.LOG_WARN)
         sys.path.insert(0, "tests")
         from test_engine import impossible_setup
@@ -526,27 +528,61 @@ def test_ctrl_c_interrupts_a_compiled_solve(checker):
     assert time.perf_counter() - began < 10.0
 
 
-def test_ctrl_c_in_a_compiled_slice_is_raised_between_slices_not_inside_it():
+@pytest.fixture
+def sigint_handler():
+    """Sets SIGINT's handler for a test (``sigint_handler(handler)``), restoring the runner's after."""
+    before = signal.getsignal(signal.SIGINT)
+    yield lambda handler: signal.signal(signal.SIGINT, handler)
+    signal.signal(signal.SIGINT, before)
+
+
+def test_ctrl_c_in_a_compiled_slice_is_raised_between_slices_not_inside_it(sigint_handler):
     """SIGINT during a slice (where Python code runs only inside a kernel's exit) sets a flag; the
     driver raises KeyboardInterrupt between slices, and at the end if it came in the last one."""
     import os
 
     from ompl_balance.engine.driver import interrupts_between_slices
 
-    handler = signal.getsignal(signal.SIGINT)  # (Python's default, or "ignore" in a background job)
+    sigint_handler(signal.default_int_handler)
     with interrupts_between_slices(exits=False):
-        assert signal.getsignal(signal.SIGINT) is handler  # kernels without exits: left as it was
-    with pytest.raises(KeyboardInterrupt), interrupts_between_slices(exits=True) as raise_interrupt:
-        raise_interrupt()  # nothing came yet
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # kernels without exits: left
+    with pytest.raises(KeyboardInterrupt), interrupts_between_slices(exits=True) as act_on_interrupt:
+        act_on_interrupt()  # nothing came yet
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.01)  # Python runs the handler here: no exception yet
         reached = True
-        raise_interrupt()
+        act_on_interrupt()
     assert reached
     with pytest.raises(KeyboardInterrupt), interrupts_between_slices(exits=True):
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.01)
-    assert signal.getsignal(signal.SIGINT) is handler  # restored
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
+
+
+def test_ctrl_c_between_slices_goes_to_the_process_own_handler_and_an_ignored_one_stays_ignored(sigint_handler):
+    """A program's own SIGINT handler is called between slices (once per signal, no
+    KeyboardInterrupt); where SIGINT is ignored (a background job) a solve leaves it ignored."""
+    import os
+
+    from ompl_balance.engine.driver import interrupts_between_slices
+
+    received: list[int] = []
+    sigint_handler(lambda number, frame: received.append(number))
+    with interrupts_between_slices(exits=True) as act_on_interrupt:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.01)
+        assert received == []  # not inside the slice
+        act_on_interrupt()
+        assert received == [signal.SIGINT]
+        act_on_interrupt()
+    assert received == [signal.SIGINT]
+    sigint_handler(signal.SIG_IGN)
+    with interrupts_between_slices(exits=True) as act_on_interrupt:
+        assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.01)
+        act_on_interrupt()
+    assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN
 
 
 def test_check_views_say_whether_their_kernels_call_python():

@@ -3,7 +3,7 @@
 :func:`run` prepares the arrays :func:`ompl_balance.engine.loop.run` works in (the
 planner's own trees, grown in place), then calls it in slices of about two milliseconds
 (the loop reads its own clock): between slices it polls the termination condition (and
-raises ``KeyboardInterrupt`` after a Ctrl-C), and it acts on why the slice stopped: a goal
+acts on a Ctrl-C: ``KeyboardInterrupt``, where the process has Python's handler), and it acts on why the slice stopped: a goal
 state to feed (OMPL's ``PlannerInputStates``), room to make in the trees, a connection for
 the goal to accept. At the end the planner's trees, swap state,
 counts and loop record hold what the compiled loop did, as if the Python engine had run.
@@ -181,31 +181,35 @@ def _grown(array: np.ndarray, rows: int) -> np.ndarray:
 
 @contextlib.contextmanager
 def interrupts_between_slices(exits: bool) -> Iterator[Callable[[], None]]:
-    """Ctrl-C during a compiled solve, raised between slices: yields ``check()``, which raises
-    ``KeyboardInterrupt`` if SIGINT came since the last call.
+    """Ctrl-C during a compiled solve, acted on between slices: yields ``check()``, which calls
+    the process's SIGINT handler (Python's raises ``KeyboardInterrupt``) if SIGINT came since
+    the last call.
 
-    Python raises ``KeyboardInterrupt`` wherever its interpreter next runs, which in a compiled
+    Python runs a signal's handler wherever its interpreter next runs, which in a compiled
     slice is inside a kernel's ``objmode`` exit to Python; numba does not carry an exception out
     of there safely (a process could crash). So while a solve whose kernels may call Python
-    (``exits``) runs, SIGINT only sets a flag (main thread only: Python delivers signals there;
-    elsewhere nothing changes). Without exits the interpreter next runs after the slice, where
-    ``KeyboardInterrupt`` is safe, and the handler stays as it was.
+    (``exits``) runs, SIGINT only sets a flag, where the process handles it in Python (main
+    thread only: Python delivers signals there). Without exits the interpreter next runs after
+    the slice, where ``KeyboardInterrupt`` is safe, and the handler stays as it was; so it does
+    where SIGINT is ignored (a background job) or left to the system (it ends the process).
     """
-    caught: list[int] = []
-    if not exits or threading.current_thread() is not threading.main_thread():
+    previous = signal.getsignal(signal.SIGINT)
+    if not exits or not callable(previous) or threading.current_thread() is not threading.main_thread():
         yield lambda: None
         return
+    handler = previous
+    caught: list[int] = []
 
     def check() -> None:
         if caught:
             caught.clear()
-            raise KeyboardInterrupt
+            handler(signal.SIGINT, None)
 
-    previous = signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
+    signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
     try:
         yield check
     finally:
-        signal.signal(signal.SIGINT, previous)
+        signal.signal(signal.SIGINT, handler)
         check()  # a SIGINT in the last slice
 
 
@@ -241,7 +245,7 @@ def run(
         ints[Slot.GOAL_FED] = 1
         return True
 
-    with interrupts_between_slices(checks.exits) as raise_interrupt:
+    with interrupts_between_slices(checks.exits) as act_on_interrupt:
         try:
             while not ptc():
                 # (a slice's first iteration asks here rather than by a stop, a slice the fewer)
@@ -252,7 +256,7 @@ def run(
                 ints[Slot.MORE_GOALS] = solve.inputs.haveMoreGoalStates()
                 stop = run_slice(checks.view, layout, settings, arrays.trees, arrays.loop, bits, SLICE_NS)
                 arrays.adopt()
-                raise_interrupt()
+                act_on_interrupt()
                 solve.progress.iterations = int(ints[Slot.ITERATIONS])
                 if stop == Stop.NEED_ROOM:
                     arrays.make_room()
