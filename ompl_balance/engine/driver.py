@@ -2,10 +2,10 @@
 
 :func:`run` prepares the arrays :func:`ompl_balance.engine.loop.run` works in (the
 planner's own trees, grown in place), then calls it in slices of about two milliseconds
-(the loop reads its own clock): between slices it polls the termination condition (and
-acts on a Ctrl-C: ``KeyboardInterrupt``, where the process has Python's handler), and it acts on why the slice stopped: a goal
-state to feed (OMPL's ``PlannerInputStates``), room to make in the trees, a connection for
-the goal to accept. At the end the planner's trees, swap state,
+(the loop reads its own clock): between slices it polls the termination condition and acts
+on a Ctrl-C (``KeyboardInterrupt``, where the process has Python's handler), and it acts on
+why the slice stopped: a goal state to feed (OMPL's ``PlannerInputStates``), room to make in
+the trees, a connection for the goal to accept. At the end the planner's trees, swap state,
 counts and loop record hold what the compiled loop did, as if the Python engine had run.
 """
 
