@@ -16,14 +16,15 @@ from .views import DiscreteMotions, PythonChecks, call_check_motion, call_is_val
 def _discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """OMPL's ``DiscreteMotionValidator::checkMotion(s1, s2)``: ``b`` first, then the states
     ``a + (j / n) (b - a)`` in the order of its queue of index ranges (the middle of each
-    range, then its halves)."""
+    range, then its halves). (The view's fields read once, first, as
+    :func:`~ompl_balance.worlds.box_kernels.box_state_free` does.)"""
+    states, layout, test, queue = view.states, view.layout, view.test, view.queue
     view.counts[Count.MOTIONS] += 1
-    if not state_free(view.states, b):
+    if not state_free(states, b):
         return False
-    n = segment_count(view.layout, a, b)
+    n = segment_count(layout, a, b)
     if n < 2:
         return True
-    queue = view.queue
     if queue.shape[0] < n:
         queue = np.empty((2 * n, 2), dtype=np.int64)
     head, tail = 0, 1
@@ -32,8 +33,8 @@ def _discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) -
         first, last = queue[head, 0], queue[head, 1]
         head = (head + 1) % queue.shape[0]
         middle = (first + last) // 2
-        interpolate(view.layout, a, b, middle / n, view.test)
-        if not state_free(view.states, view.test):
+        interpolate(layout, a, b, middle / n, test)
+        if not state_free(states, test):
             return False
         if first < middle:
             queue[tail, 0], queue[tail, 1] = first, middle - 1
