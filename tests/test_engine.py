@@ -389,10 +389,10 @@ def test_flat_layouts_have_ompls_metric_and_interpolation(space_kind):
     # uniform samples: inside the bounds, unit quaternions, the same from numpy and compiled code
     uniforms = rng.random((64, flat.total_draws))
     samples = layout.samples_from_uniforms(flat, uniforms)
+    compiled = np.empty((64, flat.dim))
+    compiled_spaces.samples_from_uniforms(flat, uniforms, compiled)
+    np.testing.assert_allclose(compiled, samples, rtol=0, atol=1e-15)
     for row in range(64):
-        out = np.empty(flat.dim)
-        compiled_spaces.sample_from_uniforms(flat, uniforms[row], out)
-        np.testing.assert_allclose(out, samples[row], rtol=0, atol=1e-15)
         space.copyFromReals(a, samples[row].tolist())
         assert space.satisfiesBounds(a)
 

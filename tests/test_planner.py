@@ -16,6 +16,7 @@ from ompl import util as ou
 from pathcheck import assert_valid_solution
 
 from ompl_balance import BalancedRRTConnect, BallRadiusRRTstar, balance_choice, read_work, tree_size_ratio
+from ompl_balance.engine.events import LoopRecord
 from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, Problem, get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
@@ -509,6 +510,33 @@ def test_fixed_seed_parameter_repeats_the_path_in_one_process():
         path = ss.getSolutionPath()
         paths.append([path.getState(i)[j] for i in range(path.getStateCount()) for j in range(2)])
     assert paths[0] == paths[1]
+
+
+def _first_targets(planner_setup, seed_after_setup: int | None = None) -> list[list[float]]:
+    """The first target of each of two solves of ``maze`` (the planner set up, then maybe reseeded)."""
+    ss = get_problem("maze").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner_setup(planner)
+    ss.setPlanner(planner)
+    ss.setup()
+    if seed_after_setup is not None:
+        planner.setSeed(seed_after_setup)
+    targets = []
+    for _ in range(2):
+        planner.loop_record = LoopRecord()
+        ss.solve(0.2)
+        targets.append([float(x) for x in planner.loop_record.steps[0].target])
+    return targets
+
+
+def test_a_seed_set_after_setup_is_the_one_solves_use():
+    # the generator made at setup for seed 5 is not used once the seed is 9: the same targets as a
+    # planner seeded 9 from the start, on both solves (each restarts the seed's stream)
+    reseeded = _first_targets(lambda p: p.setSeed(5), seed_after_setup=9)
+    seeded = _first_targets(lambda p: p.setSeed(9))
+    assert reseeded == seeded
+    assert seeded[0] == seeded[1]
+    assert seeded[0] != _first_targets(lambda p: p.setSeed(5))[0]
 
 
 # -- progress properties ----------------------------------------------------------------------

@@ -185,24 +185,30 @@ def equal(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> bool:  # pragma:
 
 
 @njit(cache=True)
-def sample_from_uniforms(layout: SpaceLayout, uniforms: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover
-    """A uniform sample of the space into ``out`` (dim,) from uniform numbers ``uniforms`` (total_draws,)."""
-    for leaf in range(len(layout.kind)):
-        start, size, first = layout.offset[leaf], layout.size[leaf], layout.draw_offset[leaf]
-        kind = layout.kind[leaf]
-        if kind == _REAL:
-            for k in range(size):
-                low = layout.low[start + k]
-                out[start + k] = low + (layout.high[start + k] - low) * uniforms[first + k]
-        elif kind == _SO2:
-            out[start] = -math.pi + (2.0 * math.pi) * uniforms[first]
-        else:
-            r1, r2 = math.sqrt(1.0 - uniforms[first]), math.sqrt(uniforms[first])
-            t1, t2 = 2.0 * math.pi * uniforms[first + 1], 2.0 * math.pi * uniforms[first + 2]
-            out[start] = math.sin(t1) * r1
-            out[start + 1] = math.cos(t1) * r1
-            out[start + 2] = math.sin(t2) * r2
-            out[start + 3] = math.cos(t2) * r2
+def samples_from_uniforms(layout: SpaceLayout, uniforms: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover
+    """Uniform samples of the space into ``out`` (rows, dim), one a row of ``uniforms`` (rows, total_draws).
+
+    One call for a block of samples, the layout's arrays read once: a call per sample that
+    passes the layout costs some 100 ns more than the sample itself.
+    """
+    kinds, offsets, sizes, draw_offsets = layout.kind, layout.offset, layout.size, layout.draw_offset
+    lows, highs = layout.low, layout.high
+    for row in range(out.shape[0]):
+        for leaf in range(len(kinds)):
+            start, size, first = offsets[leaf], sizes[leaf], draw_offsets[leaf]
+            kind = kinds[leaf]
+            if kind == _REAL:
+                for k in range(start, start + size):
+                    out[row, k] = lows[k] + (highs[k] - lows[k]) * uniforms[row, first + k - start]
+            elif kind == _SO2:
+                out[row, start] = -math.pi + (2.0 * math.pi) * uniforms[row, first]
+            else:
+                r1, r2 = math.sqrt(1.0 - uniforms[row, first]), math.sqrt(uniforms[row, first])
+                t1, t2 = 2.0 * math.pi * uniforms[row, first + 1], 2.0 * math.pi * uniforms[row, first + 2]
+                out[row, start] = math.sin(t1) * r1
+                out[row, start + 1] = math.cos(t1) * r1
+                out[row, start + 2] = math.sin(t2) * r2
+                out[row, start + 3] = math.cos(t2) * r2
 
 
 @njit(cache=True)

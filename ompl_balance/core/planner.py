@@ -171,6 +171,7 @@ class TreePlanner(ob.Planner):
         self.settings: Any = type(self).Settings()
         self._params = ParamSet.of(self.settings)
         self._rng = ou.RNG()  # per-planner stream, seeded from OMPL's global seed
+        self._prepared: tuple[int, np.random.Generator] | None = None  # (seed, the next solve's generator)
         self._points: Points | None = None  # how solves see the space (made at setup)
         self.progress = Progress()
         self.stats: Any = None
@@ -214,10 +215,27 @@ class TreePlanner(ob.Planner):
         si = self.getSpaceInformation()
         ensure_counting(si)
         self._points = points_for(si)  # how solves see the space (each restarts it with its seed)
+        self._prepare_generator()
 
     def clear(self) -> None:
         super().clear()
         self.stats = None
+        self._prepare_generator()
+
+    def _prepare_generator(self) -> None:
+        """Make the next solve's generator now where ``seed`` fixes it (at setup and clear, as
+        OMPL's planners allocate: making one costs as much as a short solve's planning)."""
+        seed = self.settings.seed
+        self._prepared = (seed, np.random.default_rng(seed)) if seed > 0 else None
+
+    def _generator(self) -> np.random.Generator:
+        """A solve's random numbers: a stream started from ``seed`` (every solve starts it
+        again), or with ``seed = 0`` from a seed drawn from the planner's OMPL RNG."""
+        seed = self.settings.seed
+        prepared, self._prepared = self._prepared, None
+        if prepared is not None and prepared[0] == seed:
+            return prepared[1]
+        return np.random.default_rng(seed or self._draw_seed())
 
     def solve(self, ptc: Limit) -> ob.PlannerStatus:
         """Plan until the search ends or ``ptc`` says stop (a condition, seconds or a callable)."""
@@ -227,7 +245,7 @@ class TreePlanner(ob.Planner):
         si = self.getSpaceInformation()
         began = time.perf_counter()
         work_before = read_work(si)
-        rng = np.random.default_rng(self.settings.seed or self._draw_seed())
+        rng = self._generator()
         # (how the last solve saw the space serves the next: allocating it costs a short solve's time)
         self._points = points_for(si, rng) if self._points is None else self._points.restarted(rng)
         self.progress = Progress()

@@ -179,6 +179,10 @@ def _grown(array: np.ndarray, rows: int) -> np.ndarray:
     return grown
 
 
+def _nothing() -> None:
+    """No SIGINT to act on (what :func:`interrupts_between_slices` yields where it leaves SIGINT alone)."""
+
+
 @contextlib.contextmanager
 def interrupts_between_slices(exits: bool) -> Iterator[Callable[[], None]]:
     """Ctrl-C during a compiled solve, acted on between slices: yields ``check()``, which calls
@@ -193,11 +197,13 @@ def interrupts_between_slices(exits: bool) -> Iterator[Callable[[], None]]:
     the slice, where ``KeyboardInterrupt`` is safe, and the handler stays as it was; so it does
     where SIGINT is ignored (a background job) or left to the system (it ends the process).
     """
-    previous = signal.getsignal(signal.SIGINT)
-    if not exits or not callable(previous) or threading.current_thread() is not threading.main_thread():
-        yield lambda: None
+    if not exits or threading.current_thread() is not threading.main_thread():
+        yield _nothing
         return
-    handler = previous
+    handler = signal.getsignal(signal.SIGINT)
+    if not callable(handler):
+        yield _nothing
+        return
     caught: list[int] = []
 
     def check() -> None:

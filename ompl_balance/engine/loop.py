@@ -27,7 +27,7 @@ from numba.extending import register_jitable
 
 from .. import policies
 from ..core.checks import motion_free, state_free
-from ..core.compiled_spaces import distance, equal, interpolate, row_distance, sample_from_uniforms, segment_count
+from ..core.compiled_spaces import distance, equal, interpolate, row_distance, samples_from_uniforms, segment_count
 from ..core.kernel_cache import njit
 from ..core.layout import SpaceLayout
 from .clock import monotonic_ns
@@ -166,8 +166,7 @@ def _uniform(layout: SpaceLayout, loop: Loop, bits: int) -> np.ndarray:  # pragm
         for row in range(loop.uniforms.shape[0]):
             for k in range(loop.uniforms.shape[1]):
                 loop.uniforms[row, k] = next_double(bits)
-        for row in range(loop.block.shape[0]):
-            sample_from_uniforms(layout, loop.uniforms[row], loop.block[row])
+        samples_from_uniforms(layout, loop.uniforms, loop.block)
         loop.ints[Slot.NEXT_SAMPLE] = 0
     row = loop.ints[Slot.NEXT_SAMPLE]
     loop.ints[Slot.NEXT_SAMPLE] = row + 1
