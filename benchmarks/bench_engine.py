@@ -3,7 +3,8 @@
 Six parts (``--part``), each printing a table of medians and ratios measured in the same
 run, planners interleaved run by run so that the machine's slow phases hit all of them. The
 two engines get the same seed in each run, so they make the same trees: their time ratio is
-the engines' speed alone.
+the engines' speed alone. Stock gets the run's seed through OMPL's RNG, so its runs too are
+the same from one run of the script to the next.
 
 ``panda``
     MotionBenchMaker Panda problems (the four shipped scenarios, the first ``--problems`` of
@@ -76,6 +77,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ompl_balance import BalancedRRTConnect
+from ompl_balance.bench.execution import seed_ompl
 from ompl_balance.collision import certified
 from ompl_balance.collision.checker import CollisionChecker
 from ompl_balance.collision.environment import Environment
@@ -95,7 +97,10 @@ KEYS = ("time", "iterations", "checks", "motions", "exits")
 
 
 def stock(si, seed: int):
-    return og.RRTConnect(si)  # (OMPL's random numbers: seeded once per process only)
+    # OMPL's RNG seeded for the run: stock's runs draw the same numbers from one run of the
+    # script to the next, whatever ran before them in the process
+    seed_ompl(seed)
+    return og.RRTConnect(si)
 
 
 def balanced(engine: str) -> Callable:

@@ -7,8 +7,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+import pytest
 from numba.core.caching import FunctionCache
 from numba.core.dispatcher import Dispatcher
+from numba.core.errors import TypingError
 
 import ompl_balance
 from ompl_balance.core import kernel_cache
@@ -108,3 +111,24 @@ def test_a_function_outside_the_package_keeps_numbas_locator(tmp_path) -> None:
     source = tmp_path / "outside.py"
     source.write_text("def h(x):\n    return x\n")
     assert PackageCacheLocator.from_function(lambda x: x, str(source)) is None
+
+
+@kernel_cache.njit_borrowing
+def _borrowed_sum(values: np.ndarray) -> float:  # pragma: no cover (compiled)
+    total = 0.0
+    for value in values:
+        total += value
+    return total
+
+
+@kernel_cache.njit_borrowing
+def _allocates(count: int) -> float:  # pragma: no cover (compiled)
+    return float(np.zeros(count).sum())
+
+
+def test_a_borrowing_kernel_reads_its_callers_arrays_and_refuses_to_allocate():
+    values = np.arange(5.0)
+    assert _borrowed_sum(values) == 10.0
+    assert values.tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]
+    with pytest.raises(TypingError):
+        _allocates(3)

@@ -130,7 +130,7 @@ def warm_up(task: RunTask) -> None:
     ss.solve(ptc)
 
 
-def _seed_ompl(seed: int) -> None:
+def seed_ompl(seed: int) -> None:
     """Seed OMPL's seed generator, from which every random generator made after this call (the
     run's problem, planner and samplers) takes its own seed.
 
@@ -166,7 +166,7 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
     The planner's progress properties, sampled every 0.05 s during the solve, go to the
     record's ``progress``. A solve that raises is recorded with OMPL's ``CRASH`` status.
     """
-    _seed_ompl(task.seed)  # before this run makes anything that draws random numbers
+    seed_ompl(task.seed)  # before this run makes anything that draws random numbers
     ss = task.problem.build()
     si = ss.getSpaceInformation()
     planner = task.planner.build(si)

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .kernel_cache import njit
+from .kernel_cache import njit, njit_borrowing
 from .layout import QUATERNION_TOLERANCE, Leaf, SpaceLayout
 
 _EPS = float(np.finfo(np.float64).eps)
@@ -105,13 +105,13 @@ def row_distance(layout: SpaceLayout, states: np.ndarray, row: int, b: np.ndarra
     return total
 
 
-@njit(cache=True)
+@njit_borrowing
 def distance(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover (compiled)
     """OMPL's distance of flat states ``a`` and ``b``."""
     return row_distance(layout, a.reshape((1, a.shape[0])), 0, b)
 
 
-@njit(cache=True)
+@njit_borrowing
 def segment_count(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> int:  # pragma: no cover (compiled)
     """OMPL's ``validSegmentCount(a, b)``: the largest over the leaves of ``factor * ceil(d / segment)``."""
     count = 0
@@ -166,7 +166,7 @@ def interpolate(
                 out[k] = (a[k] * s0 + b[k] * s1) * d
 
 
-@njit(cache=True)
+@njit_borrowing
 def equal(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover (compiled)
     """OMPL's ``equalStates``: every leaf equal within its space's tolerance."""
     for leaf in range(len(layout.kind)):
@@ -211,7 +211,7 @@ def samples_from_uniforms(layout: SpaceLayout, uniforms: np.ndarray, out: np.nda
                 out[row, start + 3] = math.cos(t2) * r2
 
 
-@njit(cache=True)
+@njit_borrowing
 def nearest(
     layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray
 ) -> tuple[int, float]:  # pragma: no cover

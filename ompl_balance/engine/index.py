@@ -46,7 +46,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..core.compiled_spaces import is_euclidean, nearest, row_distance
-from ..core.kernel_cache import njit
+from ..core.kernel_cache import njit, njit_borrowing
 from ..core.layout import Leaf, SpaceLayout
 
 #: Trees with fewer nodes are scanned (the index does not pay).
@@ -209,7 +209,7 @@ def _bound(
     return bound
 
 
-@njit(cache=True)
+@njit_borrowing
 def _select(order: np.ndarray, values: np.ndarray, column: int, lo: int, hi: int, k: int) -> None:  # pragma: no cover
     """Reorder ``order[lo:hi]`` so that ``order[k]`` has the k-th smallest ``values[., column]``,
     none after it smaller and none before it larger (Hoare's selection)."""
@@ -233,7 +233,7 @@ def _select(order: np.ndarray, values: np.ndarray, column: int, lo: int, hi: int
             return
 
 
-@njit(cache=True)
+@njit_borrowing
 def _build(index: KDIndex, lo: int, hi: int) -> None:  # pragma: no cover (compiled)
     """The k-d tree of block ``lo .. hi - 1`` (nodes with their index coordinates worked out),
     in ``order[lo:hi]``, ``points[lo:hi]``, ``axis[lo:hi]``, ``low[lo:hi]``, ``high[lo:hi]``: each
@@ -272,7 +272,7 @@ def _build(index: KDIndex, lo: int, hi: int) -> None:  # pragma: no cover (compi
             index.points[i, axis] = coordinates[order[i], axis]
 
 
-@njit(cache=True)
+@njit_borrowing
 def _add_blocks(index: KDIndex, states: np.ndarray, size: int) -> None:  # pragma: no cover (compiled)
     """Build the nodes up to the last whole :data:`BLOCK` of ``size`` into the index: their index
     coordinates worked out (once: a node's state never changes), then the blocks that the count
@@ -298,7 +298,7 @@ def _add_blocks(index: KDIndex, states: np.ndarray, size: int) -> None:  # pragm
     ints[Setting.BUILT] = new_units * BLOCK
 
 
-@njit(cache=True)
+@njit_borrowing
 def indexed_nearest(
     index: KDIndex, layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray
 ) -> tuple[int, float]:  # pragma: no cover (compiled)

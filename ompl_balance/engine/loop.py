@@ -28,7 +28,7 @@ from numba.extending import register_jitable
 from .. import policies
 from ..core.checks import motion_free, state_free
 from ..core.compiled_spaces import distance, equal, interpolate, row_distance, samples_from_uniforms, segment_count
-from ..core.kernel_cache import njit
+from ..core.kernel_cache import njit, njit_borrowing
 from ..core.layout import SpaceLayout
 from .clock import monotonic_ns
 from .events import Grow
@@ -158,10 +158,11 @@ _TRAPPED, _ADVANCED, _REACHED = int(Grow.TRAPPED), int(Grow.ADVANCED), int(Grow.
 _CHOICE, _EXTENSION, _CONNECT_STEP = 0, 1, 2  # kinds of row in the loop record
 
 
-@njit(cache=True)
-def _uniform(layout: SpaceLayout, loop: Loop, bits: int) -> np.ndarray:  # pragma: no cover (compiled)
-    """The next uniform sample (a row of the block, refilled as the Python engine refills its own
-    from the same generator: ``bits`` is its address, :mod:`ompl_balance.engine.uniforms`)."""
+@njit_borrowing
+def _uniform(layout: SpaceLayout, loop: Loop, bits: int) -> int:  # pragma: no cover (compiled)
+    """The row of ``loop.block`` holding the next uniform sample (the block refilled as the Python
+    engine refills its own from the same generator: ``bits`` is its address,
+    :mod:`ompl_balance.engine.uniforms`)."""
     if loop.ints[Slot.NEXT_SAMPLE] == loop.block.shape[0]:
         for row in range(loop.uniforms.shape[0]):
             for k in range(loop.uniforms.shape[1]):
@@ -170,10 +171,10 @@ def _uniform(layout: SpaceLayout, loop: Loop, bits: int) -> np.ndarray:  # pragm
         loop.ints[Slot.NEXT_SAMPLE] = 0
     row = loop.ints[Slot.NEXT_SAMPLE]
     loop.ints[Slot.NEXT_SAMPLE] = row + 1
-    return loop.block[row]
+    return row
 
 
-@njit(cache=True)
+@njit_borrowing
 def _find_nearest(
     settings: Settings, layout: SpaceLayout, tree: Tree, size: int, target: np.ndarray
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
@@ -224,7 +225,7 @@ def _note(loop: Loop, iteration: int, kind: int, a: int, b: int, c: int, d: int,
     return row
 
 
-@njit(cache=True)
+@njit_borrowing
 def _node_towards(
     settings: Settings,
     layout: SpaceLayout,
@@ -301,7 +302,7 @@ def _note_step(
     _copy(target, loop.record_target[row])
 
 
-@njit(cache=True)
+@njit_borrowing
 def _update_costs(layout: SpaceLayout, trees: tuple[Tree, Tree], loop: Loop, t: int) -> None:  # pragma: no cover
     """Neighbour-quality costs ``d(start, node) + d(node, goal)`` of tree ``t``'s new nodes."""
     start, goal = trees[START].states[0], trees[GOAL].states[0]
@@ -316,19 +317,25 @@ def _update_costs(layout: SpaceLayout, trees: tuple[Tree, Tree], loop: Loop, t: 
     loop.ints[Slot.START_COSTS + t] = loop.sizes[t]
 
 
-@njit(cache=True)
+#: :func:`_target`'s row for the other tree's root (a goal-biased target), not a row of the block.
+OTHER_ROOT = -1
+
+
+@njit_borrowing
 def _target(
     layout: SpaceLayout, settings: Settings, trees: tuple[Tree, Tree], loop: Loop, bits: int, t: int
-) -> tuple[np.ndarray, int, bool]:  # pragma: no cover (compiled)
-    """The iteration's target (a row of ``loop.block`` or of a tree), the node to extend when
-    the policy found it (``NO_NODE``: look it up), and ``False`` when the policy gave up."""
+) -> tuple[int, int, bool]:  # pragma: no cover (compiled)
+    """The iteration's target: its row of ``loop.block`` (:data:`OTHER_ROOT`: the other tree's
+    root), the node to extend when the policy found it (``NO_NODE``: look it up), and ``False``
+    when the policy gave up. (A row, not the array: a kernel that returns an array needs numba's
+    reference counts, see :data:`~ompl_balance.core.kernel_cache.njit_borrowing`.)"""
     policy = settings.sample_policy
     if policy == _UNIFORM:
         return _uniform(layout, loop, bits), NO_NODE, True
     other = trees[1 - t]
     if policy == _GOAL_BIAS:
         if next_double(bits) < settings.goal_bias:
-            return other.states[0], NO_NODE, True
+            return OTHER_ROOT, NO_NODE, True
         return _uniform(layout, loop, bits), NO_NODE, True
     # goal_ball and neighbour_quality: uniform targets at uniform_rate keep them complete
     if settings.uniform_rate > 0.0 and next_double(bits) < settings.uniform_rate:
@@ -338,22 +345,22 @@ def _target(
         centre = other.states[0]
         radius = distance(layout, start, goal)
         for _ in range(_SAMPLE_ATTEMPTS):
-            point = _uniform(layout, loop, bits)
-            if distance(layout, point, centre) <= radius:
-                return point, NO_NODE, True
+            row = _uniform(layout, loop, bits)
+            if distance(layout, loop.block[row], centre) <= radius:
+                return row, NO_NODE, True
             loop.ints[Slot.REJECTIONS] += 1
-        return loop.target, NO_NODE, False
+        return 0, NO_NODE, False
     _update_costs(layout, trees, loop, t)
     tree = trees[t]
     optimal = distance(layout, start, goal)
     for _ in range(_SAMPLE_ATTEMPTS):
-        point = _uniform(layout, loop, bits)
-        node, _gap = _find_nearest(settings, layout, tree, loop.sizes[t], point)
+        row = _uniform(layout, loop, bits)
+        node, _gap = _find_nearest(settings, layout, tree, loop.sizes[t], loop.block[row])
         quality = node_quality(tree.costs[node], optimal, loop.reals[Real.START_COST_MAX + t], settings.min_quality)
         if next_double(bits) < quality:
-            return point, node, True
+            return row, node, True
         loop.ints[Slot.REJECTIONS] += 1
-    return loop.target, NO_NODE, False
+    return 0, NO_NODE, False
 
 
 @njit(cache=True)
@@ -421,9 +428,10 @@ def run(
         t = START if grow_start else GOAL
         o = 1 - t
 
-        target, given, found = _target(layout, settings, trees, loop, bits, t)
+        row, given, found = _target(layout, settings, trees, loop, bits, t)
         if not found:
             continue
+        target = trees[o].states[0] if row == OTHER_ROOT else loop.block[row]
         node, gap = _node_towards(settings, layout, trees, loop, t, target, given)
         grown, added = _extend(checks, layout, settings, trees, loop, t, target, node, gap)
         if settings.record:
