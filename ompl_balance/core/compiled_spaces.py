@@ -184,7 +184,7 @@ def equal(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> bool:  # pragma:
     return True
 
 
-@njit(cache=True)
+@njit_borrowing
 def samples_from_uniforms(layout: SpaceLayout, uniforms: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover
     """Uniform samples of the space into ``out`` (rows, dim), one a row of ``uniforms`` (rows, total_draws).
 

@@ -328,7 +328,7 @@ def _target(
     """The iteration's target: its row of ``loop.block`` (:data:`OTHER_ROOT`: the other tree's
     root), the node to extend when the policy found it (``NO_NODE``: look it up), and ``False``
     when the policy gave up. (A row, not the array: a kernel that returns an array needs numba's
-    reference counts, see :data:`~ompl_balance.core.kernel_cache.njit_borrowing`.)"""
+    reference counts, see :func:`~ompl_balance.core.kernel_cache.njit_borrowing`.)"""
     policy = settings.sample_policy
     if policy == _UNIFORM:
         return _uniform(layout, loop, bits), NO_NODE, True
