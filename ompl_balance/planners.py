@@ -344,17 +344,22 @@ class BalancedRRTConnect(TreePlanner):
         if self._points is not None:  # (set up)
             self._ready_trees()
 
-    def _ready_trees(self) -> tuple[Tree, Tree]:
-        """The planner's trees (new, empty ones if it has none) and what the policies keep per
-        node; the compiled engine's arrays for them are made now where it is loaded (as OMPL's
-        planners allocate at setup and clear: a solve's time does not count them)."""
+    def _ready_trees(self) -> None:
+        """Make the planner's trees (:meth:`_trees`) and, where the compiled engine is loaded, its
+        arrays for them and its settings now (as OMPL's planners allocate at setup and clear: a
+        solve's time does not count them)."""
+        start_tree, goal_tree = self._trees()
+        points = self._points
+        if isinstance(points, ArrayPoints):
+            self._engine.prepare(points, self.settings, self.loop_record is not None, start_tree, goal_tree)
+
+    def _trees(self) -> tuple[Tree, Tree]:
+        """The planner's trees (new, empty ones if it has none) and what the policies keep per node."""
         points = self._points
         assert points is not None  # (set up)
         if self._start_tree is None or self._goal_tree is None:
             self._start_tree, self._goal_tree = points.new_tree(), points.new_tree()
             self._failures = {self._start_tree: NodeFailures(), self._goal_tree: NodeFailures()}
-        if isinstance(points, ArrayPoints):
-            self._engine.prepare(points.layout, self._start_tree, self._goal_tree)
         return self._start_tree, self._goal_tree
 
     # -- solving -------------------------------------------------------------------
@@ -364,7 +369,7 @@ class BalancedRRTConnect(TreePlanner):
     ) -> tuple[ob.PlannerStatus.PlannerStatusType, _LoopOutcome]:
         """The grow/connect loop on the engine the settings choose; returns the status and what it measured."""
         name = self.getName()
-        start_tree, goal_tree = self._ready_trees()
+        start_tree, goal_tree = self._trees()
 
         def result(
             status: ob.PlannerStatus.PlannerStatusType,

@@ -166,6 +166,39 @@ def test_goal_states_are_fed_as_the_python_engine_feeds_them():
     assert_same_run(solve(several_goals_setup, "python"), solve(several_goals_setup, "compiled"))
 
 
+class GoalRefusingOneState(ob.GoalStates):
+    """Goal states of which the last may not end a path (``isStartGoalPairValid`` refuses it)."""
+
+    def __init__(self, si):
+        super().__init__(si)
+        self.asked = 0
+
+    def isStartGoalPairValid(self, start, goal):
+        self.asked += 1
+        last = self.getState(self.getStateCount() - 1)
+        return (goal[0], goal[1]) != (last[0], last[1])
+
+
+@pytest.mark.parametrize("engine", ["python", "compiled"])
+def test_a_goal_written_in_python_is_asked_for_each_connection(engine):
+    ss = several_goals_setup()
+    si = ss.getSpaceInformation()
+    goals = GoalRefusingOneState(si)
+    for x, y in ((0.95, 0.95), (0.95, 0.05), (0.7, 0.95)):
+        goal = ss.getStateSpace().allocState()
+        goal[0], goal[1] = x, y
+        goals.addState(goal)
+    ss.setGoal(goals)
+    planner = BalancedRRTConnect(si)
+    assert planner.params().setParams({"engine": engine, "seed": "5"})
+    ss.setPlanner(planner)
+    assert ss.solve(20.0) == ob.PlannerStatus.EXACT_SOLUTION
+    end = ss.getSolutionPath().getState(ss.getSolutionPath().getStateCount() - 1)
+    # (without the refusal, this seed's paths end at the last goal state)
+    assert goals.asked >= 2
+    assert (end[0], end[1]) in ((0.95, 0.95), (0.95, 0.05))
+
+
 def shell_setup():
     """A Python callable checker (through si.isValid and si.checkMotion): a 4-D shell around the start."""
     space = ob.RealVectorStateSpace(4)

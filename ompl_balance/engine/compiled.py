@@ -27,6 +27,7 @@ from ompl import util as ou
 
 from ..core.checks import kernel_modules
 from ..core.layout import SpaceLayout
+from ..core.spaces import ArrayPoints
 from ..core.trees import Tree
 from .loading import LOADER, view_key
 from .solve import Solve
@@ -135,17 +136,19 @@ class CompiledEngine:
         else:
             LOADER.start(self._key, warm)
 
-    def prepare(self, layout: SpaceLayout, start_tree: Tree, goal_tree: Tree) -> None:
-        """Make the arrays of solves on ``start_tree`` and ``goal_tree`` now, where the engine is
-        loaded (planners call this as they make their trees, at setup and clear, which a solve's
-        time does not count)."""
+    def prepare(self, points: ArrayPoints, settings: Any, record: bool, start_tree: Tree, goal_tree: Tree) -> None:
+        """Make the arrays and the loop's settings of solves on ``start_tree`` and ``goal_tree``
+        now, where the engine is loaded (``settings``: the planner's RRTConnectSettings;
+        ``record``: whether solves record the loop). Planners call this as they make their
+        trees, at setup and clear, which a solve's time does not count."""
         if self._key is None or not LOADER.ready(self._key):
             return
         from .driver import SolveArrays
 
-        if self._arrays is None or self._arrays.layout is not layout:
-            self._arrays = SolveArrays(layout)
+        if self._arrays is None or self._arrays.layout is not points.layout:
+            self._arrays = SolveArrays(points.layout)
         self._arrays.hold(start_tree, goal_tree)
+        self._arrays.settings_for(points, settings, record)
 
     def run_of(self, solve: Solve, layout: SpaceLayout, room: int, engine: str, name: str) -> CompiledRun | None:
         """The compiled engine's run of ``solve`` where ``engine`` plans on it (:func:`runs_compiled`)

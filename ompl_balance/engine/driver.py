@@ -23,7 +23,7 @@ from ompl import base as ob
 from ..core.checks import Count
 from ..core.compiled_calls import entry_point
 from ..core.layout import SpaceLayout
-from ..core.spaces import SAMPLE_BLOCK
+from ..core.spaces import SAMPLE_BLOCK, Points
 from ..core.trees import ArrayTree
 from ..policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause
 from . import loop
@@ -39,13 +39,13 @@ from .views import EngineChecks
 SLICE_NS = 2_000_000
 
 
-def settings_of(solve: Solve) -> loop.Settings:
-    """The compiled loop's settings for ``solve``."""
-    settings = solve.settings
+def settings_of(points: Points, settings: Any, record: bool) -> loop.Settings:
+    """The compiled loop's settings for solves of a planner with ``settings`` (its
+    RRTConnectSettings) on ``points``, recording what the loop does or not."""
     return loop.Settings(
         range=float(settings.range),
         intermediate_states=bool(settings.intermediate_states),
-        step_may_stall=bool(solve.points.may_stall(settings.range)),
+        step_may_stall=bool(points.may_stall(settings.range)),
         balance_tree_sizes=bool(settings.balance_tree_sizes),
         max_tree_size_ratio=float(settings.max_tree_size_ratio),
         swap_policy=SWAP_POLICIES.index(settings.swap_policy),
@@ -57,7 +57,7 @@ def settings_of(solve: Solve) -> loop.Settings:
         goal_bias=float(settings.goal_bias),
         uniform_rate=float(settings.uniform_rate),
         min_quality=float(settings.min_quality),
-        record=solve.record is not None,
+        record=record,
     )
 
 
@@ -90,14 +90,16 @@ class SolveArrays:
         self.costs: list[np.ndarray] = []
         self.failures: list[Any] = []
         self.room = 0
+        self._fits = -1  # tree sizes up to which every array of :attr:`trees` has room for an iteration
         self._settings: tuple[tuple[Any, ...], loop.Settings] | None = None  # the last solve's, and their source
 
-    def settings_for(self, solve: Solve) -> loop.Settings:
-        """The compiled loop's settings for ``solve``: the last solve's when the planner's settings,
-        the points and recording are unchanged."""
-        source = (solve.points, solve.record is not None, *vars(solve.settings).values())
+    def settings_for(self, points: Points, settings: Any, record: bool) -> loop.Settings:
+        """The compiled loop's settings for solves of a planner with ``settings`` (its
+        RRTConnectSettings) on ``points``, recording or not: the last ones made when all three
+        are unchanged (planners ask at setup, so that a solve finds them made)."""
+        source = (points, record, *vars(settings).values())
         if self._settings is None or self._settings[0] != source:
-            self._settings = (source, settings_of(solve))
+            self._settings = (source, settings_of(points, settings, record))
         return self._settings[1]
 
     def hold(self, start_tree: ArrayTree, goal_tree: ArrayTree) -> None:
@@ -126,11 +128,21 @@ class SolveArrays:
             self.loop = self.loop._replace(
                 record=np.empty((rows, Record.COUNT), dtype=np.int64), record_target=np.empty((rows, self.layout.dim))
             )
+        self._fits = -1  # (the arrays may have moved since the last solve)
         self.make_room()
 
     def make_room(self) -> None:
         """Room for one more iteration in both trees (and the record); :attr:`trees`: the trees'
-        arrays as the loop takes them."""
+        arrays as the loop takes them.
+
+        Within a solve only the loop and the goal states fed add nodes, and neither moves an
+        array that has room, so the arrays are looked at again only when a tree outgrows them.
+        """
+        sizes = [len(tree) for tree in self._planner_trees]
+        self.loop.sizes[:] = sizes
+        self._make_record_room()
+        if max(sizes) <= self._fits:
+            return
         trees = []
         for t, tree in enumerate(self._planner_trees):
             needed = len(tree) + self.room
@@ -145,14 +157,19 @@ class SolveArrays:
             trees.append(
                 loop.Tree(storage.states, storage.parents, storage.roots, failures.array, self.costs[t], index)
             )
-            self.loop.sizes[t] = len(tree)
+        self.trees = trees[0], trees[1]
+        self._fits = (
+            min(min(len(t.states), len(t.parents), len(t.failures), len(t.costs)) for t in self.trees) - self.room
+        )
+
+    def _make_record_room(self) -> None:
+        """Room in the record (when the loop records) for one more iteration's rows."""
         record = self.loop.record
         if len(record) and len(record) - self.loop.ints[Slot.RECORDED] < self.room + 2:
             rows = 2 * len(record) + self.room
             self.loop = self.loop._replace(
                 record=_grown(record, rows), record_target=_grown(self.loop.record_target, rows)
             )
-        self.trees = trees[0], trees[1]
 
     def adopt(self) -> None:
         """The planner's trees take the nodes the loop added."""
@@ -230,7 +247,7 @@ def run(
     """The loop of ``solve`` on the compiled engine, as :func:`ompl_balance.engine.python_loop.run`,
     in ``arrays`` (``key``: the :func:`~ompl_balance.engine.loading.view_key` of ``checks.view``
     and the layout; ``room``: the nodes an iteration may add)."""
-    settings = arrays.settings_for(solve)
+    settings = arrays.settings_for(solve.points, solve.settings, solve.record is not None)
     arrays.start(solve, room, settings.record)
     layout, ints, reals = arrays.layout, arrays.loop.ints, arrays.loop.reals
     state = solve.swap_state
@@ -290,7 +307,7 @@ def _report(solve: Solve, arrays: loop.Loop, exits: int) -> None:
     )
     counts = solve.counts
     counts.iterations = int(ints[Slot.ITERATIONS])
-    counts.swaps = [int(ints[Slot.SWAPS + cause]) for cause in SwapCause]
+    counts.swaps = ints[Slot.SWAPS : Slot.SWAPS + len(SwapCause)].tolist()  # (by cause, in SwapCause order)
     counts.exits = exits
     solve.sampler_counts.rejections += int(ints[Slot.REJECTIONS])
     solve.progress.iterations = counts.iterations

@@ -77,11 +77,16 @@ class Solve:
 
     def accept(self, start_node: int, goal_node: int) -> bool:
         """Whether the goal takes the trees' roots of this connection as a start-goal pair
-        (``isStartGoalPairValid``); records it if so."""
-        points = self.points
-        start_root = points.ompl_state(self.start_tree.state(self.start_tree.root(start_node)), 0)
-        goal_root = points.ompl_state(self.goal_tree.state(self.goal_tree.root(goal_node)), 1)
-        if self.goal.isStartGoalPairValid(start_root, goal_root):
-            self.connection = (start_node, goal_node)
-            return True
-        return False
+        (``isStartGoalPairValid``); records it if so.
+
+        OMPL's own goal classes keep ``Goal::isStartGoalPairValid``, which takes every pair, so
+        only a goal written in Python is asked (the roots made OMPL states for it).
+        """
+        if type(self.goal).__module__ != ob.Goal.__module__:
+            points = self.points
+            start_root = points.ompl_state(self.start_tree.state(self.start_tree.root(start_node)), 0)
+            goal_root = points.ompl_state(self.goal_tree.state(self.goal_tree.root(goal_node)), 1)
+            if not self.goal.isStartGoalPairValid(start_root, goal_root):
+                return False
+        self.connection = (start_node, goal_node)
+        return True
