@@ -224,10 +224,10 @@ def true_distance(first, second, first_pose, second_pose) -> float:
 def bounds_at(parts, first, first_poses, second, second_poses, starts):  # pragma: no cover (compiled)
     """GJK's bounds for each pose pair, each from its own start direction."""
     out = np.empty((len(first_poses), 2))
-    directions = np.zeros((1, 3))
+    directions, simplex = np.zeros((1, 3)), np.empty((4, 3))
     for k in range(len(first_poses)):
         directions[0] = starts[k]
-        out[k] = distance_bounds(parts, first, first_poses, k, second, second_poses, k, directions, 0, np.inf)
+        out[k] = distance_bounds(parts, first, first_poses, k, second, second_poses, k, directions, 0, simplex, np.inf)
     return out
 
 

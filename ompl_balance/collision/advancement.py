@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..core.kernel_cache import njit
+from ..core.kernel_cache import njit, njit_borrowing
 from .convex import ConvexParts, Vector, distance_bounds
 from .kinematics import Chain, chain_poses
 from .screening import SLACK, Volumes
@@ -141,13 +141,21 @@ def sphere_bounds(
 
 @njit(cache=True, inline="always")
 def hull_bounds(
-    pair: int, poses: np.ndarray, volumes: Volumes, model: Model, warm: np.ndarray, identity: np.ndarray, enough: float
+    pair: int,
+    poses: np.ndarray,
+    volumes: Volumes,
+    model: Model,
+    warm: np.ndarray,
+    identity: np.ndarray,
+    simplex: np.ndarray,
+    enough: float,
 ) -> tuple[float, float]:  # pragma: no cover (compiled)
     """Lower and upper bounds (m) on ``pair``'s distance at body ``poses`` from GJK on its convex parts.
 
     ``warm`` (pairs, 3) holds each pair's last GJK direction; ``identity`` (1, 4, 4) places
-    the obstacles. Stops once the lower bound reaches ``enough``. The lower bound is less
-    :data:`~ompl_balance.collision.screening.SLACK` for rounding.
+    the obstacles; ``simplex`` (4, 3) is GJK's scratch. Stops once the lower bound reaches
+    ``enough``. The lower bound is less :data:`~ompl_balance.collision.screening.SLACK` for
+    rounding.
     """
     if not math.isnan(model.fixed[pair]):
         return model.fixed[pair], model.fixed[pair]
@@ -160,7 +168,7 @@ def hull_bounds(
             for axis in range(3):
                 warm[pair, axis] = centre[axis] - model.obstacle_centre[o, axis]
         lower, upper = distance_bounds(
-            model.parts, g, poses, body, geometries + o, identity, 0, warm, pair, enough + SLACK
+            model.parts, g, poses, body, geometries + o, identity, 0, warm, pair, simplex, enough + SLACK
         )
         return lower - SLACK, upper
     first, second = volumes.pairs[pair - environment, 0], volumes.pairs[pair - environment, 1]
@@ -171,7 +179,7 @@ def hull_bounds(
         for axis in range(3):
             warm[pair, axis] = centre[axis] - other[axis]
     lower, upper = distance_bounds(
-        model.parts, first, poses, first_body, second, poses, second_body, warm, pair, enough + SLACK
+        model.parts, first, poses, first_body, second, poses, second_body, warm, pair, simplex, enough + SLACK
     )
     return lower - SLACK, upper
 
@@ -302,7 +310,7 @@ def end_memory(rows: int, dof: int, pairs: int) -> EndMemory:
     )
 
 
-@njit(cache=True)
+@njit_borrowing
 def memory_row(memory: EndMemory, q: np.ndarray) -> int:  # pragma: no cover (compiled)
     """The row of configuration ``q`` (dof,) in ``memory``; the oldest row, cleared, if ``q`` is not remembered."""
     keys = memory.keys
@@ -380,7 +388,7 @@ def advance(
     geometries, obstacles = len(volumes.outer_radius), len(volumes.box_half)
     pairs = obstacles * geometries + len(volumes.pairs)
     delta = b - a
-    identity = np.eye(4).reshape(1, 4, 4)
+    identity, simplex = np.eye(4).reshape(1, 4, 4), np.empty((4, 3))  # (GJK's obstacle pose and scratch)
     contact = clearance + DISTANCE_TOLERANCE
     for g in range(geometries):
         rate = 0.0
@@ -450,7 +458,7 @@ def advance(
                     continue
                 point = seg_point[e, side]
                 target = need - seg_lower[e, 1 - side]
-                lower, upper = hull_bounds(pair, point_poses[point], volumes, model, warm, identity, target)
+                lower, upper = hull_bounds(pair, point_poses[point], volumes, model, warm, identity, simplex, target)
                 bounded += 1
                 seg_lower[e, side] = max(seg_lower[e, side], lower)
                 seg_final[e, side] = lower < target
@@ -519,7 +527,9 @@ def advance(
                 lower, final = spheres[i], False
                 spare = spheres[i] + min(seg_lower[e, 0], seg_lower[e, 1]) - 2.0 * clearance
                 if lower < target and not (spare > 0.0 and 0.5 * speed[pair] * width <= SPHERE_REACH * spare):
-                    lower, upper = hull_bounds(pair, point_poses[middle], volumes, model, warm, identity, target)
+                    lower, upper = hull_bounds(
+                        pair, point_poses[middle], volumes, model, warm, identity, simplex, target
+                    )
                     bounded += 1
                     lower, final = max(lower, spheres[i]), lower < target
                     if model.solid[pair] and upper <= contact:

@@ -281,13 +281,15 @@ class MotionCertifier:
         """
         q = np.ascontiguousarray(q, dtype=float)
         poses = self._robot.body_poses(q)[0]
-        warm = np.zeros((self.pair_count, 3))
+        warm, simplex = np.zeros((self.pair_count, 3)), np.empty((4, 3))
         volumes = self.checker.volumes
         pairs = np.arange(self.pair_count)
         lower = np.empty(self.pair_count)
         sphere_bounds(poses, volumes, self._model, pairs, lower)
         for pair in range(self.pair_count):
-            lower[pair] = max(lower[pair], hull_bounds(pair, poses, volumes, self._model, warm, self._identity, 0.0)[0])
+            lower[pair] = max(
+                lower[pair], hull_bounds(pair, poses, volumes, self._model, warm, self._identity, simplex, 0.0)[0]
+            )
         best = np.inf
         for pair in np.argsort(lower):
             if lower[pair] >= best:

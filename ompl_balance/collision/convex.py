@@ -58,7 +58,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.spatial
 
-from ..core.kernel_cache import njit
+from ..core.kernel_cache import njit, njit_borrowing
 
 #: GJK stops when its lower and upper bounds are within this many metres.
 GJK_TOLERANCE = 1e-9
@@ -334,23 +334,22 @@ def _closest_on_triangle(a: Vector, b: Vector, c: Vector) -> tuple[Vector, int, 
     return _along(_along(a, vb / total, ab), vc / total, ac), 0, 1, 2, 3
 
 
-@njit(cache=True)
+@njit_borrowing
 def _keep(simplex: np.ndarray, i: int, j: int, k: int, count: int) -> int:  # pragma: no cover (compiled)
-    """Keep rows ``i, j, k`` (the first ``count`` of them, in order) of ``simplex`` at its front."""
+    """Keep rows ``i < j < k`` (the first ``count`` of them) of ``simplex`` at its front."""
     rows = (i, j, k)
-    kept = np.empty((3, 3))
     for r in range(count):
-        kept[r] = simplex[rows[r]]
-    simplex[:count] = kept[:count]
+        row = rows[r]  # (ascending, so row >= r: the rows still to move are not yet overwritten)
+        simplex[r, 0], simplex[r, 1], simplex[r, 2] = simplex[row, 0], simplex[row, 1], simplex[row, 2]
     return count
 
 
-@njit(cache=True)
+@njit_borrowing
 def _row(simplex: np.ndarray, i: int) -> Vector:  # pragma: no cover (compiled)
     return (simplex[i, 0], simplex[i, 1], simplex[i, 2])
 
 
-@njit(cache=True)
+@njit_borrowing
 def _closest_on_simplex(simplex: np.ndarray, n: int) -> tuple[Vector, int]:  # pragma: no cover (compiled)
     """Closest point to the origin on the simplex ``simplex[:n]``; reduces the simplex to the
     points that span it and returns the point and their number (4 with the origin inside)."""
@@ -364,7 +363,7 @@ def _closest_on_simplex(simplex: np.ndarray, n: int) -> tuple[Vector, int]:  # p
         if t <= 0.0:
             return a, 1
         if t >= 1.0:
-            simplex[0] = simplex[1]
+            simplex[0, 0], simplex[0, 1], simplex[0, 2] = b
             return b, 1
         return _along(a, t, ab), 2
     if n == 3:
@@ -396,7 +395,7 @@ def _closest_on_simplex(simplex: np.ndarray, n: int) -> tuple[Vector, int]:  # p
     return best_v, _keep(simplex, best_rows[0], best_rows[1], best_rows[2], best_count)
 
 
-@njit(cache=True)
+@njit_borrowing
 def distance_bounds(
     parts: ConvexParts,
     first: int,
@@ -407,6 +406,7 @@ def distance_bounds(
     second_body: int,
     directions: np.ndarray,
     row: int,
+    simplex: np.ndarray,
     enough: float,
 ) -> tuple[float, float]:  # pragma: no cover (compiled)
     """Lower and upper bounds (m) on the distance between parts ``first`` and ``second``, placed at
@@ -414,6 +414,7 @@ def distance_bounds(
 
     Starts from ``directions[row]`` (3,), any nonzero vector of ``first - second`` (e.g. the
     result of an earlier call for the same pair), and leaves GJK's last direction there.
+    ``simplex`` (4, 3) is GJK's working simplex (scratch: the kernel allocates nothing).
     Stops as soon as the lower bound reaches ``enough``, when the bounds meet within
     :data:`GJK_TOLERANCE`, or after :data:`GJK_ITERATIONS`. Touching or overlapping parts
     give an upper bound of 0 (and a lower bound of at most 0).
@@ -421,7 +422,6 @@ def distance_bounds(
     v = (directions[row, 0], directions[row, 1], directions[row, 2])
     if _dot(v, v) == 0.0:
         v = (1.0, 0.0, 0.0)
-    simplex = np.empty((4, 3))
     n = 0
     lower, upper = -np.inf, np.inf  # upper: the nearest point of D seen (the start direction is none)
     for _ in range(GJK_ITERATIONS):

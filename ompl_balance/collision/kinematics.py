@@ -29,7 +29,7 @@ import trimesh
 import yourdfpy
 from numpy.typing import ArrayLike
 
-from ..core.kernel_cache import njit
+from ..core.kernel_cache import njit, njit_borrowing
 from .geometry import Shape
 from .urdf import check_urdf
 
@@ -85,7 +85,7 @@ class Chain(NamedTuple):
     axis: np.ndarray
 
 
-@njit(cache=True)
+@njit_borrowing
 def chain_poses(q: np.ndarray, chain: Chain, poses: np.ndarray) -> None:  # pragma: no cover (compiled)
     """World poses of the bodies of one configuration ``q`` (dof,) into ``poses`` (bodies, 4, 4)."""
     poses[0] = 0.0
@@ -96,8 +96,8 @@ def chain_poses(q: np.ndarray, chain: Chain, poses: np.ndarray) -> None:  # prag
         sin, cos = np.sin(value), np.cos(value)
         parent = poses[chain.parent_body[k]]  # an earlier body: never the one written here
         body = poses[k + 1]
-        body[:3, :3] = 0.0
-        body[:3, 3] = parent[:3, 3]
+        for row in range(3):
+            body[row, 0], body[row, 1], body[row, 2], body[row, 3] = 0.0, 0.0, 0.0, parent[row, 3]
         # body = parent @ local, each entry of the joint's local transform computed once
         for m in range(3):
             for col in range(3):

@@ -75,7 +75,7 @@ class RigidView(NamedTuple):
     the length scale of the tolerances (``max(1, reach)``).
 
     Work arrays (written by the kernels): ``pose`` (1, 4, 4), ``identity`` (1, 4, 4), ``warm``
-    (P, 3) last GJK direction per pair, ``placed_part`` (G, 3) and ``placed_sphere`` (S, 3) the
+    (P, 3) last GJK direction per pair, ``simplex`` (4, 3) GJK's working simplex, ``placed_part`` (G, 3) and ``placed_sphere`` (S, 3) the
     spheres' world centres at ``pose``, ``undecided`` (P,) pairs left to FCL by
     :func:`state_status`, ``hard`` (H, 5) segments ``(pair, t0, t1, d0, d1)`` left to FCL by
     ``edge_status``, ``reached`` (1,) the fraction of the motion ``edge_status`` certified up to
@@ -109,6 +109,7 @@ class RigidView(NamedTuple):
     pose: np.ndarray
     identity: np.ndarray
     warm: np.ndarray
+    simplex: np.ndarray
     placed_part: np.ndarray
     placed_sphere: np.ndarray
     undecided: np.ndarray
@@ -181,6 +182,7 @@ def build_view(
         pose=np.eye(4).reshape(1, 4, 4).copy(),
         identity=np.eye(4).reshape(1, 4, 4),
         warm=np.zeros((pairs, 3)),
+        simplex=np.zeros((4, 3)),
         placed_part=np.zeros((len(body.parts), 3)),
         placed_sphere=np.zeros((sum(len(r) for _, r in small), 3)),
         undecided=np.zeros(pairs, dtype=np.int64),
@@ -287,7 +289,9 @@ def hull_bound(
         warm[pair, 0] = x - view.obstacle_centre[o, 0]
         warm[pair, 1] = y - view.obstacle_centre[o, 1]
         warm[pair, 2] = z - view.obstacle_centre[o, 2]
-    lower, upper = distance_bounds(view.parts, g, poses, 0, parts + o, view.identity, 0, warm, pair, enough + SLACK)
+    lower, upper = distance_bounds(
+        view.parts, g, poses, 0, parts + o, view.identity, 0, warm, pair, view.simplex, enough + SLACK
+    )
     return lower - SLACK, upper
 
 
