@@ -272,11 +272,13 @@ class EdgeModel(NamedTuple):
 
 class EdgeScratch(NamedTuple):
     """What :func:`advance` writes besides the remembered bounds: ``warm`` (pairs, 3) each
-    pair's last GJK direction, ``speed`` (pairs,) each pair's travel bound per unit ``t`` on the
-    last edge, and the hard segments, pair ``hard_pair[i]`` (capacity,) over ``hard_span[i]`` =
-    (t0, t1, d0, d1) (capacity, 4), grown when needed."""
+    pair's last GJK direction, ``simplex`` (4, 3) GJK's working simplex, ``speed`` (pairs,) each
+    pair's travel bound per unit ``t`` on the last edge, and the hard segments, pair
+    ``hard_pair[i]`` (capacity,) over ``hard_span[i]`` = (t0, t1, d0, d1) (capacity, 4), grown
+    when needed."""
 
     warm: np.ndarray
+    simplex: np.ndarray
     speed: np.ndarray
     hard_pair: np.ndarray
     hard_span: np.ndarray
@@ -379,7 +381,8 @@ def advance(
     """
     chain, volumes, model = edge.chain, edge.volumes, edge.model
     clearance, handover, floor = edge.clearance, edge.handover, edge.floor
-    warm, speed, hard_pair, hard_span = scratch.warm, scratch.speed, scratch.hard_pair, scratch.hard_span
+    warm, simplex, speed = scratch.warm, scratch.simplex, scratch.speed
+    hard_pair, hard_span = scratch.hard_pair, scratch.hard_span
     dof = len(a)
     for j in range(dof):
         for value in (a[j], b[j]):  # (NaN fails both comparisons)
@@ -388,7 +391,7 @@ def advance(
     geometries, obstacles = len(volumes.outer_radius), len(volumes.box_half)
     pairs = obstacles * geometries + len(volumes.pairs)
     delta = b - a
-    identity, simplex = np.eye(4).reshape(1, 4, 4), np.empty((4, 3))  # (GJK's obstacle pose and scratch)
+    identity = np.eye(4).reshape(1, 4, 4)
     contact = clearance + DISTANCE_TOLERANCE
     for g in range(geometries):
         rate = 0.0

@@ -137,6 +137,7 @@ class MotionCertifier:
         capacity = 4 * self.pair_count + 16  # hard segments before the arrays grow
         self._scratch = EdgeScratch(
             np.zeros((self.pair_count, 3)),
+            np.empty((4, 3)),
             np.empty(self.pair_count),
             np.empty(capacity, dtype=np.int64),
             np.empty((capacity, 4)),
@@ -281,7 +282,7 @@ class MotionCertifier:
         """
         q = np.ascontiguousarray(q, dtype=float)
         poses = self._robot.body_poses(q)[0]
-        warm, simplex = np.zeros((self.pair_count, 3)), np.empty((4, 3))
+        warm, simplex = np.zeros((self.pair_count, 3)), self._scratch.simplex
         volumes = self.checker.volumes
         pairs = np.arange(self.pair_count)
         lower = np.empty(self.pair_count)

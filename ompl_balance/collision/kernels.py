@@ -395,7 +395,9 @@ def warm_up() -> None:
         joint_upper=q,
     )
     edge = EdgeModel(chain, volumes, model, 0.0, 0.01, MIN_TRAVEL)
-    scratch = EdgeScratch(np.zeros((0, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), np.zeros((1, 4)))
+    scratch = EdgeScratch(
+        np.zeros((0, 3)), np.zeros((4, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), np.zeros((1, 4))
+    )
     certified = CertifiedMotions(states, edge, end_memory(2, 1, 0), scratch, 0, states.counts)
     certified_motion_free(certified, q, q)
     certified_edge_free(edge, certified.memory, scratch, states.counts, 0, q, q)  # (the Python callers')

@@ -75,8 +75,8 @@ class RigidView(NamedTuple):
     the length scale of the tolerances (``max(1, reach)``).
 
     Work arrays (written by the kernels): ``pose`` (1, 4, 4), ``identity`` (1, 4, 4), ``warm``
-    (P, 3) last GJK direction per pair, ``simplex`` (4, 3) GJK's working simplex, ``placed_part`` (G, 3) and ``placed_sphere`` (S, 3) the
-    spheres' world centres at ``pose``, ``undecided`` (P,) pairs left to FCL by
+    (P, 3) last GJK direction per pair, ``simplex`` (4, 3) GJK's working simplex,
+    ``placed_part`` (G, 3) and ``placed_sphere`` (S, 3) the spheres' world centres at ``pose``, ``undecided`` (P,) pairs left to FCL by
     :func:`state_status`, ``hard`` (H, 5) segments ``(pair, t0, t1, d0, d1)`` left to FCL by
     ``edge_status``, ``reached`` (1,) the fraction of the motion ``edge_status`` certified up to
     them, ``counts`` (4,) (see :data:`UNDECIDED_PAIRS` and after).
