@@ -15,7 +15,11 @@
    meshes, so it misses a body inside a box obstacle; the package's boxes are FCL's solids.
 3. **Certified against discrete**: stock ``og.RRTConnect`` with the certified and the discrete
    validator (OMPL's ``validSegmentCount`` states per motion, at OMPL's default resolution),
-   interleaved: median and total planning time, their ratio, and paths colliding in the re-check.
+   interleaved and paired: run ``i`` of both validators starts from OMPL's seed ``i``, so both
+   draw the same samples and their trees differ only where the validators' answers do (a
+   run's time varies a hundredfold from seed to seed on the harder problems, which unpaired runs
+   leave in the ratio); median and total planning time, their ratios, the median of the
+   per-seed ratios, and paths colliding in the re-check.
 
 With ``OMPLAPP_RESOURCES`` naming a copy of OMPL.app's ``resources`` folder, sections 2 and 3 also
 run on ``--omplapp`` problems (default: Easy, cubicles, Twistycool, alpha-1.5; ``--omplapp-runs``
@@ -46,6 +50,7 @@ from ompl import util as ou
 from scipy.spatial.transform import Rotation
 
 from ompl_balance import BalancedRRTConnect
+from ompl_balance.bench.execution import seed_ompl
 from ompl_balance.collision.rigid.checker import RigidBodyChecker
 from ompl_balance.collision.rigid.motion import interpolate_many, motion_split
 from ompl_balance.collision.rigid.view import UNDECIDED, state_status
@@ -223,25 +228,28 @@ def certified_against_discrete(problems: dict[str, RigidBodyProblem], runs: int,
         return
     print(f"\n## 3. Certified against discrete motions: stock RRTConnect's planning time ({runs} runs)\n")
     print(
-        "| problem | validator | success | median time (s) | total time (s) | colliding paths | median ratio | total ratio |"
+        "| problem | validator | success | median time (s) | total time (s) | colliding paths | median ratio "
+        "| total ratio | per-seed ratio (median) |"
     )
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     for name, problem in problems.items():
         limit = float(problem.time_limit or 10.0)
         results: dict[str, list[dict]] = {"certified": [], "discrete": []}
-        for _ in range(runs):
+        for seed in range(1, runs + 1):
             for motion, motion_runs in results.items():
+                seed_ompl(seed)  # both validators' run from the same seed: paired
                 motion_runs.append(plan(problem, "RRTConnect", motion, limit, step))
         discrete = results["discrete"]
         for motion, motion_runs in results.items():
             solved = [r for r in motion_runs if r["solved"]]
             median = statistics.median(r["time"] for r in motion_runs)
             total = sum(r["time"] for r in motion_runs)
+            per_seed = statistics.median(r["time"] / d["time"] for r, d in zip(motion_runs, discrete, strict=True))
             print(
                 f"| {name} | {motion} | {success(motion_runs):.0%} | {median:.3f} | {total:.1f} "
                 f"| {sum(1 for r in solved if r['colliding'])}/{len(solved)} "
                 f"| {median / statistics.median(r['time'] for r in discrete):.2f} "
-                f"| {total / sum(r['time'] for r in discrete):.2f} |",
+                f"| {total / sum(r['time'] for r in discrete):.2f} | {per_seed:.2f} |",
                 flush=True,
             )
 

@@ -1,9 +1,13 @@
 """Test session settings."""
 
+import atexit
 import os
+import shutil
 import tempfile
 
 # The tests compute what the package caches on disk (covering spheres, certified-free
 # tables) afresh, in a cache of their own, rather than reading a user's cache: a change
 # to those computations must be tested, not served from an earlier version's files.
+# It is removed when the test session's process exits.
 os.environ["OMPL_BALANCE_CACHE"] = tempfile.mkdtemp(prefix="ompl_balance_test_cache_")
+atexit.register(shutil.rmtree, os.environ["OMPL_BALANCE_CACHE"], ignore_errors=True)

@@ -6,8 +6,10 @@ FCL's collision test at poses along OMPL's interpolation so dense that no point 
 more than ``STEP`` between two; neither shares the screening, the bounds or the advancement.
 """
 
+import itertools
 import math
 
+import fcl
 import numpy as np
 import pytest
 import trimesh
@@ -335,6 +337,45 @@ def test_probing_a_motion_changes_no_answer_and_refuses_colliding_motions_withou
     assert probed.counters()["distance_queries"] < 0.5 * unprobed.counters()["distance_queries"]
     for work in ("motions_checked", "distance_queries"):  # compiled code probes and counts alike
         assert compiled.counters()[work] == probed.counters()[work]
+
+
+def test_distances_at_motions_ends_are_kept_and_change_no_answer(monkeypatch):
+    """Motions that share their ends, as a planner's do (a path walked forth and back): the
+    checker keeps FCL's exact distances at the ends, so it asks FCL less often than checkers
+    that see each motion afresh, and answers every motion as they do (and certified motions are
+    free under the dense check)."""
+    rng = np.random.default_rng(5)
+    environment, _ = mesh_world(rng, count=16)
+    body = RigidBody.from_triangles("SE3", l_mesh(), pieces=2)
+    low, high = np.full(3, -1.2), np.full(3, 1.2)
+    calls = [0]
+    fcl_distance = fcl.distance
+
+    def counted(*arguments):
+        calls[0] += 1
+        return fcl_distance(*arguments)
+
+    monkeypatch.setattr(fcl, "distance", counted)
+    keeping = RigidBodyChecker(body, environment, (low, high))
+    walk = [next(s for s in random_states("SE3", 100, rng, low, high) if keeping.is_valid(s))]
+    for target in random_states("SE3", 200, rng, low, high):  # short steps, as a planner's range
+        step = np.empty(7)
+        interpolate(walk[-1], target, 0.1, step)
+        step[3:] /= np.linalg.norm(step[3:])
+        if keeping.is_valid(step):
+            walk.append(step)
+    motions = list(itertools.pairwise(walk))
+    motions += [(b, a) for a, b in motions]  # every end met again
+    calls[0] = 0
+    kept = [keeping.certify(a, b, last_valid=True) for a, b in motions]
+    with_memory, calls[0] = calls[0], 0
+    afresh = [RigidBodyChecker(body, environment, (low, high)).certify(a, b, last_valid=True) for a, b in motions]
+    assert kept == afresh
+    assert 0 < with_memory < 0.9 * calls[0]
+    dense = DenseCheck(body, environment, STEP)
+    for (a, b), (certified, _) in zip(motions, kept):
+        if certified:
+            assert dense.first_collision(a, b) is None
 
 
 def test_clearance_keeps_motions_away():

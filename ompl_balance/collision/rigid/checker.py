@@ -64,6 +64,8 @@ _REQUEST = fcl.CollisionRequest()
 #: The pair index of the whole body against the whole world (both meshes) in the FCL phase.
 WHOLE = -1
 _DISTANCE_REQUEST = fcl.DistanceRequest()
+#: How many exact distances at motions' ends a checker keeps (oldest dropped first).
+END_DISTANCES_KEPT = 1024
 
 
 class RigidBodyChecker:
@@ -104,6 +106,10 @@ class RigidBodyChecker:
         self.clearance = float(clearance)
         self.counter = WorkCounter()
         self.bounds = self._position_bounds(bounds)
+        # FCL's exact distances at motions' ends, by (pair, state): a planner's motions start
+        # from tree states again and again, and a connection's next motion starts where its
+        # last one ended
+        self._end_distances: dict[tuple[int, bytes], float] = {}
         obstacles = self.environment.obstacles
         self._parts = [fcl.CollisionObject(p.shape.fcl_geometry(), fcl.Transform()) for p in body.parts]
         self._part_pose = [None if np.array_equal(p.pose, np.eye(4)) else p.pose for p in body.parts]
@@ -403,6 +409,7 @@ class RigidBodyChecker:
         exact: dict[tuple[int, float], float] = {}
         touches: dict[tuple[int, float], bool] = {}
         state = np.empty(len(a))
+        ends = self._end_distances
         whole_body, whole_world = self._whole_body, self._whole_world
         if whole_body is not None and whole_world is not None and segments:
             segments = [(WHOLE, t0, t1, -np.inf, -np.inf) for t0, t1 in _spans(segments)]
@@ -432,12 +439,19 @@ class RigidBodyChecker:
 
         def distance(pair: int, t: float) -> float:
             if (pair, t) not in exact:
-                if touching(pair, t):
+                end = (pair, (a if t == 0.0 else b).tobytes()) if t in (0.0, 1.0) else None
+                if end is not None and end in ends:
+                    exact[pair, t] = ends.pop(end)  # (kept again below, as the newest)
+                elif touching(pair, t):
                     exact[pair, t] = -np.inf
                 else:
                     counter.distance_queries += 1
                     found = fcl.distance(*placed(pair, t), _DISTANCE_REQUEST, fcl.DistanceResult())
                     exact[pair, t] = found - DISTANCE_TOLERANCE * scale
+                if end is not None:
+                    ends[end] = exact[pair, t]
+                    if len(ends) > END_DISTANCES_KEPT:
+                        del ends[next(iter(ends))]
             return exact[pair, t]
 
         # contacts first: a collision test is cheaper than a distance, which a segment its ends
