@@ -684,6 +684,27 @@ def test_a_fresh_processs_first_half_second_solve_returns_in_time():
     assert elapsed < 1.0
 
 
+def test_a_process_exits_cleanly_while_the_engine_loads():
+    """A short script's solve ends while the compiled engine still loads in the background (auto
+    plans on Python meanwhile): the process lets the load finish, exits with 0, and nanobind's
+    own check at shutdown finds no OMPL object left alive."""
+    script = textwrap.dedent(
+        """
+        from ompl import util as ou
+        ou.setLogLevel(ou.LOG_WARN)
+        from ompl_balance import BalancedRRTConnect, get_problem
+        ss = get_problem("narrow_gap").setup()
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        ss.setPlanner(planner)
+        print(bool(ss.solve(0.5)), planner.stats.engine)
+        """
+    )
+    result = subprocess.run([sys.executable, "-c", script], check=False, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["True", "python"]  # (the engine was still loading)
+    assert "leaked" not in result.stderr
+
+
 # -- what the compiled engine refuses -------------------------------------------------------------
 
 

@@ -6,11 +6,13 @@ code on disk, so only the first use after an install compiles (tens of seconds);
 processes load it (about a second, most of it numba's own start-up). :class:`EngineLoader`
 does either in a background thread: ``engine=auto`` solves on the Python engine until the
 compiled one is ready, ``engine=compiled`` waits for it, with a message on standard error
-when the wait exceeds a second.
+when the wait exceeds a second. A process does not exit in the middle of it (the work is
+kept in numba's cache).
 """
 
 from __future__ import annotations
 
+import atexit
 import os
 import pickle
 import sys
@@ -23,6 +25,9 @@ import numpy as np
 
 #: Seconds a solve waits for the compiled engine before it says that it is compiling.
 QUIET_WAIT = 1.0
+#: Seconds a process about to exit waits for the engine's loading before it says so (loading
+#: from numba's cache takes a second or two; compiling, tens of seconds).
+EXIT_QUIET_WAIT = 3.0
 
 
 def view_key(value: Any) -> Any:
@@ -130,6 +135,23 @@ class EngineLoader:
         for thread in list(self._threads.values()):
             thread.join()
 
+    def finish_before_exit(self) -> None:
+        """Let a background compilation end before the interpreter does, saying so on standard
+        error when that takes more than :data:`EXIT_QUIET_WAIT`. A thread cut off at exit would
+        leave numba's work undone (the next process compiles again) and OMPL objects alive while
+        Python shuts down, which nanobind reports as leaks."""
+        running = [thread for thread in self._threads.values() if thread.is_alive()]
+        began = time.perf_counter()
+        for thread in running:
+            thread.join(max(0.0, EXIT_QUIET_WAIT - (time.perf_counter() - began)))
+        if any(thread.is_alive() for thread in running):
+            sys.stderr.write(
+                "ompl_balance: the planning engine is still compiling; waiting for it before exit "
+                "(numba caches it for later processes)...\n"
+            )
+            sys.stderr.flush()
+            self.finish()
+
     def _warm(self, key: Hashable, warm: Callable[[], None]) -> None:
         try:
             try:
@@ -161,3 +183,4 @@ def forget_cached_kernels() -> None:
 
 LOADER = EngineLoader()
 os.register_at_fork(before=LOADER.finish)
+atexit.register(LOADER.finish_before_exit)
