@@ -1,7 +1,9 @@
 """The compiled engine against the Python engine and stock OMPL, measured in one run.
 
 Six parts (``--part``), each printing a table of medians and ratios measured in the same
-run, planners interleaved run by run so that the machine's slow phases hit all of them. The
+run, planners interleaved run by run so that the machine's slow phases hit all of them. Before
+the timed runs of a Panda scenario or a 2-D problem each planner solves it once untimed
+(:func:`warm_up`). The
 two engines get the same seed in each run, so they make the same trees: their time ratio is
 the engines' speed alone. Stock gets the run's seed through OMPL's RNG, so its runs too are
 the same from one run of the script to the next.
@@ -135,6 +137,15 @@ def measure(ss, make_planner, time_limit: float, seed: int) -> dict:
     }
 
 
+def warm_up(make_setup: Callable, time_limit: float) -> None:
+    """One untimed solve by each planner before a table's timed runs, as ``ompl-balance bench``
+    warms a run up: a process's first solve on a kind of problem pays one-time costs (the
+    Python engine's first pass through its code, the compiled engine's first call of a newly
+    loaded loop: about 0.5-1 ms on a 2-D problem) that are not a solve's."""
+    for make in PLANNERS.values():
+        measure(make_setup(), make, time_limit, seed=0)
+
+
 def dense_collisions(reference: CollisionChecker, states: np.ndarray, step: float) -> int:
     """Segments of the path ``states`` (n, dof) with a colliding state at most ``step`` rad apart."""
     colliding = 0
@@ -180,7 +191,13 @@ def panda(args) -> None:
     colliding = solved = 0
     for scenario in SCENARIOS:
         rows: dict[str, list[dict]] = {name: [] for name in PLANNERS}
-        for problem in load_mbm(scenario, robot.joint_names)[: args.problems]:
+        problems = load_mbm(scenario, robot.joint_names)[: args.problems]
+
+        def first_setup(problem=problems[0]):
+            return problem.simple_setup(robot, CollisionChecker(robot, problem.environment))
+
+        warm_up(first_setup, args.time_limit)
+        for problem in problems:
             for run in range(args.runs):
                 for name, make in PLANNERS.items():
                     ss = problem.simple_setup(robot, CollisionChecker(robot, problem.environment))
@@ -218,6 +235,7 @@ def two_d(args) -> None:
     cases["bug_trap (Python callable)"] = bug_trap_callable_setup
     for label, make_setup in cases.items():
         rows: dict[str, list[dict]] = {name: [] for name in PLANNERS}
+        warm_up(make_setup, TIME_LIMIT_2D)
         for run in range(args.runs_2d):
             for name, make in PLANNERS.items():
                 rows[name].append(measure(make_setup(), make, TIME_LIMIT_2D, seed=1 + run))
