@@ -116,16 +116,12 @@ class EngineLoader:
         """Make the engine for ``key`` ready now (compiled, or loaded from numba's cache), saying on
         standard error when that takes more than a second."""
         self.start(key, warm)
-        thread = self._threads[key]
         began = time.perf_counter()
-        thread.join(QUIET_WAIT)
-        if thread.is_alive():
-            sys.stderr.write(
-                f"ompl_balance: preparing the planning engine for {what} (numba compiles it on first use, tens "
-                "of seconds; later processes load it from numba's cache, a second or two)...\n"
-            )
-            sys.stderr.flush()
-            thread.join()
+        message = (
+            f"preparing the planning engine for {what} (numba compiles it on first use, tens "
+            "of seconds; later processes load it from numba's cache, a second or two)"
+        )
+        if _join_saying([self._threads[key]], QUIET_WAIT, message):
             sys.stderr.write(f"ompl_balance: planning engine ready after {time.perf_counter() - began:.0f} s\n")
         if key in self._errors:
             raise RuntimeError(f"the compiled engine for {what} failed to compile") from self._errors[key]
@@ -140,17 +136,10 @@ class EngineLoader:
         error when that takes more than :data:`EXIT_QUIET_WAIT`. A thread cut off at exit would
         leave numba's work undone (the next process compiles again) and OMPL objects alive while
         Python shuts down, which nanobind reports as leaks."""
-        running = [thread for thread in self._threads.values() if thread.is_alive()]
-        began = time.perf_counter()
-        for thread in running:
-            thread.join(max(0.0, EXIT_QUIET_WAIT - (time.perf_counter() - began)))
-        if any(thread.is_alive() for thread in running):
-            sys.stderr.write(
-                "ompl_balance: the planning engine is still compiling; waiting for it before exit "
-                "(numba caches it for later processes)...\n"
-            )
-            sys.stderr.flush()
-            self.finish()
+        message = (
+            "the planning engine is still compiling; waiting for it before exit (numba caches it for later processes)"
+        )
+        _join_saying(list(self._threads.values()), EXIT_QUIET_WAIT, message)
 
     def _warm(self, key: Hashable, warm: Callable[[], None]) -> None:
         try:
@@ -166,6 +155,21 @@ class EngineLoader:
             self._errors[key] = error
             return
         self._ready.add(key)
+
+
+def _join_saying(threads: list[threading.Thread], quiet: float, message: str) -> bool:
+    """Wait for ``threads`` to end; if they run longer than ``quiet`` seconds, say ``message`` on
+    standard error first. Whether it was said."""
+    began = time.perf_counter()
+    for thread in threads:
+        thread.join(max(0.0, quiet - (time.perf_counter() - began)))
+    if not any(thread.is_alive() for thread in threads):
+        return False
+    sys.stderr.write(f"ompl_balance: {message}...\n")
+    sys.stderr.flush()
+    for thread in threads:
+        thread.join()
+    return True
 
 
 def forget_cached_kernels() -> None:
