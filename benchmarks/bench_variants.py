@@ -1,6 +1,8 @@
 """The classroom RRT-Connect variants (PRESETS) against stock og.RRTConnect, in one run.
 
-Per problem and planner: success, median time, median collision queries (states the
+Per problem and planner: the engine its runs took (``compiled`` or ``python`` for the
+package's planners, each run on the engine it will use, as ``ompl-balance bench`` runs them;
+``C++`` for stock), success, median time, median collision queries (states the
 validity checker decided, including those inside motion checks and inside a valid-state
 sampler: one counter, no double counting), median nodes (both trees; stock's from
 ``getPlannerData``), each with its ratio to stock RRTConnect's median in the same run.
@@ -17,7 +19,7 @@ goal in pockets that open away from each other: every way out leaves the goal ba
 ``ControlChosenRRTConnect``) and ``circle`` (SO(2), an obstacle between 0.5 and 1.0 rad,
 start 0, goal 1.5: the way goes round the far side, where no obstacle is near). With
 ``--mbm N``, also the first N problems of each shipped MotionBenchMaker Panda scenario with
-VAMP's Panda (exact FCL checks, ~0.3-0.5 ms per state: keep N small).
+VAMP's Panda, the package's checker and certified motions (``--mbm 3``: about a minute).
 
 Run: python benchmarks/bench_variants.py [--runs 20] [--time-limit 10] [--mbm 0] [--planners ...]
 """
@@ -106,6 +108,8 @@ def mbm_problems(count: int) -> dict[str, Callable[[], og.SimpleSetup]]:
 
 
 def run(make_setup, make_planner, time_limit: float) -> dict:
+    """One solve (set up outside the timing; the package's planners on the engine they will
+    use for every run, as ``ompl-balance bench`` runs them) and its work."""
     ss = make_setup()
     si = ss.getSpaceInformation()
     planner = make_planner(si)
@@ -113,12 +117,18 @@ def run(make_setup, make_planner, time_limit: float) -> dict:
     run = measured_solve(ss, time_limit)
     stats = getattr(planner, "stats", None)
     if stats is not None:
-        nodes = stats.start_tree_size + stats.goal_tree_size
+        nodes, engine = stats.start_tree_size + stats.goal_tree_size, stats.engine
     else:
         data = ob.PlannerData(si)
         ss.getPlannerData(data)
-        nodes = data.numVertices()
-    return {"solved": run.solved, "time": run.time, "queries": run.work.states_checked, "nodes": nodes}
+        nodes, engine = data.numVertices(), "C++"
+    return {
+        "solved": run.solved,
+        "time": run.time,
+        "queries": run.work.states_checked,
+        "nodes": nodes,
+        "engine": engine,
+    }
 
 
 def main() -> None:
@@ -152,10 +162,10 @@ def main() -> None:
 
     print(f"{args.runs} runs per cell, time limit {args.time_limit:g} s; ratios are to stock RRTConnect's medians\n")
     print(
-        "| problem | planner | success | median time (ms) | median collision queries | median nodes "
+        "| problem | planner | engine | success | median time (ms) | median collision queries | median nodes "
         "| time ratio | queries ratio | nodes ratio |"
     )
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     query_ratios: dict[str, dict[str, float]] = {name: {} for name in planners}
     for problem, make_setup in problems.items():
         results: dict[str, list[dict]] = {name: [] for name in planners}
@@ -166,8 +176,9 @@ def main() -> None:
         for name, runs in results.items():
             m, ratio = cell[name], ratios(cell[name], cell["RRTConnect"])
             query_ratios[name][problem] = ratio["queries"]
+            engines = "/".join(sorted({r["engine"] for r in runs}))
             print(
-                f"| {problem} | {name} | {success(runs):.0%} | {m['time'] * 1e3:.1f} | {m['queries']:.0f} "
+                f"| {problem} | {name} | {engines} | {success(runs):.0%} | {m['time'] * 1e3:.1f} | {m['queries']:.0f} "
                 f"| {m['nodes']:.0f} | {ratio['time']:.2f} | {ratio['queries']:.2f} | {ratio['nodes']:.2f} |",
                 flush=True,
             )

@@ -705,6 +705,27 @@ def test_a_process_exits_cleanly_while_the_engine_loads():
     assert "leaked" not in result.stderr
 
 
+def test_measured_solve_times_a_fresh_processs_solve_on_the_compiled_engine():
+    """The benchmark scripts' timed solve (``measured_solve``) has the planner load its engine
+    first, untimed: in a fresh process, where ``auto`` would plan the first solves on Python while
+    the compiled engine loads (the test above), the timed solve runs compiled."""
+    script = textwrap.dedent(
+        """
+        from ompl import util as ou
+        ou.setLogLevel(ou.LOG_WARN)
+        from ompl_balance import BalancedRRTConnect, get_problem
+        from ompl_balance.core.counting import measured_solve
+        ss = get_problem("narrow_gap").setup()
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        ss.setPlanner(planner)
+        print(measured_solve(ss, 10.0).solved, planner.stats.engine)
+        """
+    )
+    result = subprocess.run([sys.executable, "-c", script], check=False, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["True", "compiled"]
+
+
 # -- what the compiled engine refuses -------------------------------------------------------------
 
 

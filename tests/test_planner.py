@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import threading
 import time
 
@@ -16,6 +17,7 @@ from ompl import util as ou
 from pathcheck import assert_valid_solution
 
 from ompl_balance import BalancedRRTConnect, BallRadiusRRTstar, balance_choice, read_work, tree_size_ratio
+from ompl_balance.core.counting import measured_solve
 from ompl_balance.engine.events import LoopRecord
 from ompl_balance.worlds.boxes import PROBLEMS, BoxWorld2D, Problem, get_problem
 
@@ -341,6 +343,30 @@ def test_impossible_problem_times_out_on_time():
     # The time limit is honoured (a bound no loaded machine reaches; the exact claim, one
     # check of the condition per iteration, is the next test's).
     assert elapsed < 0.2 + 2.0
+
+
+def test_measured_solve_keeps_its_time_limit_without_a_thread_of_ompl():
+    """The benchmark scripts' timed solve: OMPL's time limit, evaluated where the planner asks.
+    ``ss.solve(seconds)`` with a limit of a second or more starts a thread of its own to evaluate
+    it, whose end costs every planner up to a millisecond a solve; no thread may start here."""
+    if not os.path.isdir("/proc/self/task"):
+        pytest.skip("counts the process's threads in Linux's /proc")
+    walled = (*get_problem("narrow_gap").boxes[0][:3], 1.0)  # close the gap: never solved
+    world = BoxWorld2D((walled,))
+    threads_seen: list[int] = []
+
+    def free(state) -> bool:  # the walled world, counting the process's threads as the planner runs
+        threads_seen.append(len(os.listdir("/proc/self/task")))
+        return world.is_free(state[0], state[1])
+
+    ss = get_problem("narrow_gap").setup()
+    ss.setStateValidityChecker(free)
+    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+    before = len(os.listdir("/proc/self/task"))
+    run = measured_solve(ss, 1.0)
+    assert not run.solved  # (stock reports its closest approach as an approximate solution)
+    assert 1.0 <= run.time < 1.0 + 2.0  # (a bound no loaded machine reaches)
+    assert len(threads_seen) > 100 and max(threads_seen) <= before
 
 
 def test_the_python_engine_checks_the_termination_condition_once_per_iteration():
