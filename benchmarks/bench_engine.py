@@ -226,21 +226,17 @@ def bug_trap_callable_setup():
     return ss
 
 
-#: 2-D time limit (s): the 2-D solves take milliseconds.
-TIME_LIMIT_2D = 1.0
-
-
 def two_d(args) -> None:
-    print(f"\n2-D problems, {args.runs_2d} runs each, {TIME_LIMIT_2D:g} s limit\n")
+    print(f"\n2-D problems, {args.runs_2d} runs each, {args.time_limit:g} s limit\n")
     print(HEADER)
     cases = {name: get_problem(name).setup for name in ("open", "narrow_gap", "bug_trap", "maze")}
     cases["bug_trap (Python callable)"] = bug_trap_callable_setup
     for label, make_setup in cases.items():
         rows: dict[str, list[dict]] = {name: [] for name in PLANNERS}
-        warm_up(make_setup, TIME_LIMIT_2D)
+        warm_up(make_setup, args.time_limit)
         for run in range(args.runs_2d):
             for name, make in PLANNERS.items():
-                rows[name].append(measure(make_setup(), make, TIME_LIMIT_2D, seed=1 + run))
+                rows[name].append(measure(make_setup(), make, args.time_limit, seed=1 + run))
         table(rows, label)
 
 
