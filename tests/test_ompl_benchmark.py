@@ -64,3 +64,47 @@ def test_the_log_of_ompls_benchmark_holds_the_package_planners_parameters_and_gr
         assert all(states > 0 for states, _ in logged)
     stock_runs = [states for planner, states, _ in runs if planner == "geometric_RRTConnect"]
     assert len(stock_runs) == RUNS and all(states > 0 for states in stock_runs)  # Benchmark's own reading
+
+
+def test_two_configurations_under_one_name_are_logged_each_with_its_own_parameters_and_runs(tmp_path):
+    """Two BalancedRRTConnect with the default name and different ratios: each log entry holds its
+    own planner's parameters and, run by run, the graph sizes and iterations that planner counted
+    (what Benchmark recorded is matched by position, not by name)."""
+    ss = get_problem("bug_trap").setup()
+    si = ss.getSpaceInformation()
+    benchmark = ot.Benchmark(ss, "one_name")
+    default, halved = BalancedRRTConnect(si), BalancedRRTConnect(si)
+    halved.setMaxTreeSizeRatio(0.5)
+    halved.setRange(0.05)  # a different search: the two planners' runs differ
+    stock = og.RRTConnect(si)
+    for planner in (default, stock, halved):
+        benchmark.addPlanner(planner)
+    counted: dict[int, list[tuple[int, int]]] = {id(default): [], id(halved): []}
+
+    def post_run(planner, run):
+        if id(planner) in counted:
+            stats = planner.stats
+            counted[id(planner)].append((stats.start_tree_size + stats.goal_tree_size, stats.iterations))
+
+    request = ot.Request(0.5, 1000.0, RUNS, 0.05, True, False, True)
+    request.displayProgress = False
+    run_ompl_benchmark(benchmark, request, post_run=post_run)
+    log = tmp_path / "one_name.log"
+    benchmark.saveResultsToFile(str(log))
+    database = tmp_path / "one_name.db"
+    ot.readBenchmarkLog(str(database), [str(log)], False)
+
+    with sqlite3.connect(database) as db:
+        configs = db.execute("SELECT id, name, settings FROM plannerConfigs ORDER BY id").fetchall()
+        runs = db.execute("SELECT plannerid, graph_states, iterations FROM runs ORDER BY id").fetchall()
+    balanced = [
+        (config_id, settings) for config_id, name, settings in configs if name == "geometric_BalancedRRTConnect"
+    ]
+    assert len(balanced) == 2, configs  # two configurations, not one merged entry
+    (first_id, first_settings), (second_id, second_settings) = balanced
+    assert "max_tree_size_ratio = 1" in first_settings and "range = 0" in first_settings
+    assert "max_tree_size_ratio = 0.5" in second_settings and "range = 0.05" in second_settings
+    for config_id, planner in ((first_id, default), (second_id, halved)):
+        logged = [(states, iterations) for plannerid, states, iterations in runs if plannerid == config_id]
+        assert logged == counted[id(planner)]
+    assert counted[id(default)] != counted[id(halved)]

@@ -20,6 +20,7 @@ Stock planners' entries are left as ``Benchmark`` made them.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 from ompl import base as ob
@@ -46,25 +47,51 @@ def run_ompl_benchmark(
     into ``benchmark``'s recorded experiment, so that ``saveResultsToFile`` logs them.
 
     ``post_run`` is your own post-run event, if any (this function sets the benchmark's).
+
+    What a run reports is matched to the run ``Benchmark`` recorded by position, not by name:
+    ``Benchmark`` runs its planners in the order they were added, all runs of one before the
+    next, and calls the post-run event once for every run it records. Two configurations of
+    one planner under the same name (two ``BalancedRRTConnect(si)`` with different
+    ``max_tree_size_ratio``) are logged each with its own parameters and runs.
     """
-    reports: dict[str, list[dict[str, str]]] = {}  # per planner name, one report per run
-    params: dict[str, dict[str, str]] = {}
+    reports: list[_RunReport | None] = []  # one per recorded run, in Benchmark's order (None: a stock planner)
 
     def collect(planner: ob.Planner, run: Any) -> None:
-        if _is_package_planner(planner):
-            name = planner.getName()
-            params.setdefault(name, planner_params(planner))
-            properties = {**graph_properties(planner), **stats_properties(planner, _MEASURED_BY_BENCHMARK)}
-            reports.setdefault(name, []).append({key: ompl_text(value) for key, value in properties.items()})
+        reports.append(_report(planner) if _is_package_planner(planner) else None)
         if post_run is not None:
             post_run(planner, run)
 
     benchmark.setPostRunEvent(collect)
     benchmark.benchmark(request)
-    for experiment in benchmark.getRecordedExperimentData().planners:  # Benchmark's own data, written in place
-        name = experiment.name.removeprefix("geometric_").removeprefix("control_")
-        for key, value in params.get(name, {}).items():
+    experiments = benchmark.getRecordedExperimentData().planners  # Benchmark's own data, written in place
+    recorded = sum(len(experiment.runs) for experiment in experiments)
+    if recorded != len(reports):
+        raise RuntimeError(
+            f"ompl.tools.Benchmark recorded {recorded} runs but called the post-run event {len(reports)} times; "
+            "the package planners' properties were not written, as they could not be matched to their runs"
+        )
+    first = 0
+    for experiment in experiments:
+        runs = experiment.runs
+        own = reports[first : first + len(runs)]
+        first += len(runs)
+        for run, report in zip(runs, own):
+            if report is not None:
+                for key, value in report.properties.items():
+                    run[key] = value
+        params = next((report.params for report in own if report is not None), {})
+        for key, value in params.items():
             experiment.common[key] = value
-        for run, report in zip(experiment.runs, reports.get(name, [])):
-            for key, value in report.items():
-                run[key] = value
+
+
+@dataclass(frozen=True)
+class _RunReport:
+    """What one run of a package planner reports: its parameters and its run properties (OMPL's strings)."""
+
+    params: dict[str, str]
+    properties: dict[str, str]
+
+
+def _report(planner: ob.Planner) -> _RunReport:
+    properties = {**graph_properties(planner), **stats_properties(planner, _MEASURED_BY_BENCHMARK)}
+    return _RunReport(planner_params(planner), {key: ompl_text(value) for key, value in properties.items()})
