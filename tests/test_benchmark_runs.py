@@ -13,10 +13,12 @@ from pathlib import Path
 
 import pytest
 from ompl import base as ob
+from ompl import geometric as og
 from test_benchmark import deterministic
 
 from ompl_balance.bench.compare import bench
 from ompl_balance.bench.experiment import Experiment, PlannerSpec
+from ompl_balance.bench.isolation import preload_modules, start_forkserver
 from ompl_balance.bench.problems import ProblemSpec
 
 REPO = Path(__file__).resolve().parents[1]
@@ -58,11 +60,14 @@ def test_crash_and_hang_are_recorded_and_the_sweep_goes_on(tmp_path):
         runs=2,
         time_limit=0.5,
         seed=3,
-        hard_limit_margin=1.0,
+        # a run's process imports this test module (and pytest) to build its planner: seconds on a
+        # loaded machine, which the hard limit (2 x 0.5 + 4 s) must leave the segfaulting runs
+        hard_limit_margin=4.0,
     )
+    start_forkserver(preload_modules(experiment))  # (numba compiles the kernels it preloads on a first use)
     began = time.perf_counter()
     records = bench(experiment, tmp_path, jobs=2, progress=False)
-    assert time.perf_counter() - began < 30  # the hung runs were killed at 2 x 0.5 + 1 s
+    assert time.perf_counter() - began < 60  # the hung runs were killed at 2 x 0.5 + 4 s
     status = {(r["planner"], r["run"]): r["status"] for r in records}
     assert status == {
         ("RRTConnect", 0): "EXACT_SOLUTION",
@@ -79,6 +84,82 @@ def test_crash_and_hang_are_recorded_and_the_sweep_goes_on(tmp_path):
     assert "\nsegfault\n" in log and "\nhang\n" in log  # failed runs are in the OMPL log too
     assert "2 crashed" in (tmp_path / "summary.md").read_text()
     assert all(r["properties"]["status ENUM"] == 7 for r in records if r["planner"] != "RRTConnect")
+
+
+# -- a run that solves, then stalls in path simplification ----------------------------------
+
+#: Set by StraightLinePlanner's solve: the validity checker stalls from then on (simplification).
+_SOLVED = [False]
+
+
+def stalling_after_solve_world() -> og.SimpleSetup:
+    """An open square whose validity checker sleeps a minute per state once the planner solved."""
+
+    def is_valid(state: ob.State) -> bool:
+        if _SOLVED[0]:
+            time.sleep(60.0)
+        return True
+
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(is_valid)
+    start, goal = space.allocState(), space.allocState()
+    start[0], start[1], goal[0], goal[1] = 0.1, 0.1, 0.9, 0.9
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
+class StraightLinePlanner(ob.Planner):
+    """Solves at once with a three-state straight line from the start to the goal."""
+
+    def __init__(self, si):
+        super().__init__(si, "StraightLine")
+
+    def solve(self, ptc):
+        pdef = self.getProblemDefinition()
+        si = self.getSpaceInformation()
+        start, goal = pdef.getStartState(0), pdef.getGoal().getState()
+        middle = si.allocState()
+        si.getStateSpace().interpolate(start, goal, 0.5, middle)
+        path = og.PathGeometric(si)
+        for state in (start, middle, goal):
+            path.append(state)
+        pdef.addSolutionPath(path, False, 0.0, self.getName())
+        _SOLVED[0] = True
+        return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
+
+
+def straight_line_planner(si: ob.SpaceInformation) -> ob.Planner:
+    return StraightLinePlanner(si)
+
+
+def test_a_run_that_solved_then_overran_in_simplification_is_recorded_as_solved(tmp_path):
+    """Killed at the hard limit while simplifying: the record is the solve's (solved, its time and
+    length), not a crash of the planner, and its note says that simplification did not return."""
+    experiment = Experiment(
+        name="stall",
+        problems=(ProblemSpec("stall", "factory", "test_benchmark_runs:stalling_after_solve_world"),),
+        planners=(PlannerSpec("line", factory="test_benchmark_runs:straight_line_planner"),),
+        runs=1,
+        time_limit=0.5,
+        seed=3,
+        hard_limit_margin=4.0,  # (the run's process imports this module: seconds on a loaded machine)
+        warm_up=False,
+    )
+    start_forkserver(preload_modules(experiment))
+    began = time.perf_counter()
+    (record,) = bench(experiment, tmp_path, jobs=1, progress=False)
+    assert time.perf_counter() - began < 40  # killed at 2 x 0.5 + 4 s, not after the checker's minute
+    assert record["status"] == "EXACT_SOLUTION" and record["error"] == ""
+    properties = record["properties"]
+    assert properties["solved BOOLEAN"] == 1
+    assert properties["solution length REAL"] == pytest.approx(0.8 * 2**0.5)
+    assert properties["time REAL"] < 0.5
+    assert properties["simplification time REAL"] > 0.5  # it ran until the kill
+    assert "simplified solution length REAL" not in properties
+    assert "path simplification" in record["note"] and "did not return" in record["note"]
+    assert "crashed" not in (tmp_path / "summary.md").read_text()
 
 
 RESUME_TOML = """\

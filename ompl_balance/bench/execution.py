@@ -30,8 +30,10 @@ from .planner_properties import graph_properties, stats_properties, typed
 from .progress_sampler import ProgressSampler, improves_cost, progress_properties
 from .results import STATUS_INDEX, Record, failure_properties, run_record, status_name
 
-#: The phases of a run, in order, as :func:`execute` reports them.
-PHASES = ("warm-up", "solve", "simplification")
+#: The phases of a run, in order, as :func:`execute` reports them. ``"engine"``: a planner of the
+#: package makes its compiled engine ready (loaded, or compiled on a first use after installing),
+#: which the run waits for untimed; ``"simplification"`` comes with the record of the solve.
+PHASES = ("engine", "warm-up", "solve", "simplification")
 
 
 def _peak_memory() -> float:
@@ -148,15 +150,17 @@ def seed_ompl(seed: int) -> None:
         ou.setLogLevel(level)
 
 
-def _no_phase(phase: str) -> None:
+def _no_phase(phase: str, record: Record | None = None) -> None:
     """The default phase report of :func:`execute`: none."""
 
 
-def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
+def execute(task: RunTask, phase: Callable[[str, Record | None], None] = _no_phase) -> Record:
     """Run ``task`` in this process and return its record (call in a fresh process: it seeds OMPL).
 
     ``phase`` is told each of :data:`PHASES` as it starts (the process that waits for the
-    run says which one a killed run was in).
+    run says which one a killed run was in), and with ``"simplification"`` the record of the
+    solve as it stands before the path is simplified: a run killed while simplifying is
+    recorded with what its solve did, not as a crash of the planner.
 
     Properties (OMPL log names and types): time, memory, status, solved, approximate
     solution, solution length and segments, simplification time, simplified solution
@@ -184,6 +188,7 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
     ss.setup()  # not timed: setup wraps the checker to count, loads compiled scans, ...
     wait_for_engine = getattr(planner, "wait_for_engine", None)
     if wait_for_engine is not None:
+        phase("engine", None)
         wait_for_engine()  # every solve on the compiled engine, where it applies (not timed)
     params = planner_params(planner)
     if run_seeded:
@@ -195,11 +200,11 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
     began = time.perf_counter()
     try:
         if task.warm_up:
-            phase("warm-up")
+            phase("warm-up", None)
             warm_up(task)  # its own problem and planner: neither timed nor counted
             work_before, began = read_work(si), time.perf_counter()
         ptc = ob.timedPlannerTerminationCondition(task.time_limit)
-        phase("solve")
+        phase("solve", None)
         with memory.watch(ptc), sampler:
             # The sampling and memory threads run already: their start and end are the
             # harness's cost, not the planner's (a Python thread's start costs as much as a
@@ -221,7 +226,8 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
         "solved BOOLEAN": int(ss.haveExactSolutionPath()),
         **_work_properties(work.states_checked, work.motions_checked, work.distance_queries),
     }
-    if ss.haveSolutionPath():
+    solved = ss.haveSolutionPath()
+    if solved:
         path = ss.getSolutionPath()  # keep the owner while reading it
         properties.update(
             [
@@ -230,7 +236,14 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
                 typed("solution segments", path.getStateCount() - 1),
             ]
         )
-        phase("simplification")
+    properties.update(graph_properties(planner))
+    properties.update(stats_properties(planner, _MEASURED_HERE))
+    properties["memory REAL"] = _peak_memory() - memory.start  # MB the run added (OMPL: after minus before)
+    record = run_record(task, status_text, properties, params, "", improving)
+    if memory.reached:
+        record["note"] = f"stopped at the memory limit of {task.memory_limit:g} MB"
+    if solved:
+        phase("simplification", _finish(record, planner, sampler))
         began = time.perf_counter()
         ss.simplifySolution(task.time_limit)
         properties["simplification time REAL"] = time.perf_counter() - began
@@ -241,12 +254,6 @@ def execute(task: RunTask, phase: Callable[[str], None] = _no_phase) -> Record:
                 typed("simplified solution segments", simplified.getStateCount() - 1),
             ]
         )
-    properties.update(graph_properties(planner))
-    properties.update(stats_properties(planner, _MEASURED_HERE))
-    properties["memory REAL"] = _peak_memory() - memory.start  # MB the run added (OMPL: after minus before)
-    record = run_record(task, status_text, properties, params, "", improving)
-    if memory.reached:
-        record["note"] = f"stopped at the memory limit of {task.memory_limit:g} MB"
     return _finish(record, planner, sampler)
 
 

@@ -7,13 +7,16 @@ after it, so each run seeds it with its own seed
 (:func:`~ompl_balance.bench.experiment.run_seed`) before it builds anything, and stock
 planners repeat too, their generators made in the run's process alone; and a run
 that segfaults, aborts or ignores its time limit takes only its own process down. The
-parent waits at most ``task.hard_limit`` seconds (2 x the time limit + a margin: planning,
-then simplification bounded by the time limit) and records OMPL's ``CRASH`` status for a
-process that died or had to be killed, saying in which phase of the run
-(:data:`~ompl_balance.bench.execution.PHASES`). A planner that did not return from its solve
-is then solved once more in a plain ``ss.solve(time_limit)`` in a process of its own (no
-warm-up, no progress or memory thread), and the record says whether that returned: whether
-the planner hangs (or dies) by itself or only under the benchmark.
+parent gives the run ``task.hard_limit`` seconds (2 x the time limit + a margin: planning,
+then simplification bounded by the time limit), not counting the wait for a planner's compiled
+engine (the ``"engine"`` phase: numba compiles it on a first use after installing, which is
+no fault of the run; it has :data:`ENGINE_LIMIT` seconds of its own). It records OMPL's
+``CRASH`` status for a process that died or had to be killed, saying in which phase of the run
+(:data:`~ompl_balance.bench.execution.PHASES`), except a run killed while simplifying its
+solution: that run's record is its solve's, with a note that simplification overran. A planner
+that did not return from its solve is then solved once more in a plain ``ss.solve(time_limit)``
+in a process of its own (no warm-up, no progress or memory thread), and the record says whether
+that returned: whether the planner hangs (or dies) by itself or only under the benchmark.
 """
 
 from __future__ import annotations
@@ -34,6 +37,10 @@ from .execution import KEEP_UNTIL_EXIT, WARM_UP_TIME, execute
 from .experiment import Experiment, RunTask
 from .problems import PROBLEM_KINDS
 from .results import Record, failure_properties, failure_record, run_record
+
+#: Seconds a run may wait for a planner's compiled engine (numba compiling every kernel once after
+#: installing took about four minutes on a loaded 2-core machine), apart from its hard limit.
+ENGINE_LIMIT = 900.0
 
 # "__main__" too: a run's process then need not re-import the main script (spawn semantics)
 _PRELOAD = ["__main__", "ompl_balance.bench.preload_runs"]
@@ -90,8 +97,12 @@ def _child(task: RunTask, connection: Any) -> None:
     """Entry point of a run's process: run, reporting each phase, then send the record (or the traceback)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C stops the sweep, which ends its runs
     ou.setLogLevel(ou.LogLevel.LOG_ERROR)
+
+    def phase(name: str, record: Record | None) -> None:
+        connection.send((name, record))
+
     try:
-        connection.send(execute(task, phase=connection.send))
+        connection.send(execute(task, phase=phase))
     except BaseException:
         connection.send(
             run_record(task, "CRASH", failure_properties("CRASH", 0.0), error=traceback.format_exc(limit=-3))
@@ -145,6 +156,7 @@ def plain_solve(task: RunTask) -> str:
 
 _PHASE_WORDS = {
     None: "while building its problem and planner",
+    "engine": "while loading its compiled engine",
     "warm-up": "in the untimed warm-up solve",
     "solve": "in the timed solve",
     "simplification": "in the path simplification",
@@ -160,8 +172,11 @@ def _not_returned(task: RunTask, phase: str | None, phase_began: float, killed: 
     )
     if phase is None:
         return f"the run did not get to planning ({_PHASE_WORDS[None]}); {kill}"
-    if phase == "simplification":
-        return f"path simplification, bounded by the time limit of {task.time_limit:g} s, did not return; {kill}"
+    if phase == "engine":
+        return (
+            f"{planner}'s compiled engine was not ready after {killed - phase_began:.0f} s "
+            f"(the limit of {ENGINE_LIMIT:g} s for loading or compiling it); the process was killed"
+        )
     if phase == "warm-up":
         ended = (
             "the untimed warm-up solve, which its termination condition ended after at most "
@@ -205,11 +220,10 @@ def run_isolated(task: RunTask, preload: list[str] | None = None) -> Record:
     process.start()
     _RUNNING[task.key] = process
     sender.close()
-    phase: str | None = None
-    phase_began = began
-    deadline = began + task.hard_limit
+    clock = _RunClock(task.hard_limit, began)
+    solved: Record | None = None  # the solve's record, once the run simplifies its solution
     try:
-        while receiver.poll(max(0.0, deadline - time.perf_counter())):
+        while receiver.poll(max(0.0, clock.deadline() - time.perf_counter())):
             try:
                 message = receiver.recv()
             except EOFError:  # the process died without a word
@@ -218,21 +232,59 @@ def run_isolated(task: RunTask, preload: list[str] | None = None) -> Record:
                     task,
                     "CRASH",
                     time.perf_counter() - began,
-                    f"{_exit_text(process.exitcode)} {_PHASE_WORDS[phase]}",
+                    f"{_exit_text(process.exitcode)} {_PHASE_WORDS[clock.phase]}",
                 )
             if isinstance(message, dict):
                 return message
-            phase, phase_began = message, time.perf_counter()
+            phase, record = message
+            clock.enter(phase, time.perf_counter())
+            if record is not None:
+                solved = record
         killed = time.perf_counter()
         if process.is_alive():
             process.kill()
-        return failure_record(task, "CRASH", killed - began, _not_returned(task, phase, phase_began, killed))
+        if clock.phase == "simplification" and solved is not None:
+            return _simplification_overran(task, solved, killed - clock.phase_began)
+        return failure_record(
+            task, "CRASH", killed - began, _not_returned(task, clock.phase, clock.phase_began, killed)
+        )
     finally:
         receiver.close()
         if process.is_alive():
             process.kill()
         process.join()
         _RUNNING.pop(task.key, None)
+
+
+class _RunClock:
+    """The deadline of a run's process: ``hard_limit`` seconds of its phases but the ``"engine"``
+    phase, which has :data:`ENGINE_LIMIT` seconds of its own."""
+
+    def __init__(self, hard_limit: float, began: float) -> None:
+        self.phase: str | None = None
+        self.phase_began = began
+        self._left = hard_limit  # s of the hard limit not spent before the current phase
+
+    def enter(self, phase: str, now: float) -> None:
+        if self.phase != "engine":
+            self._left -= now - self.phase_began
+        self.phase, self.phase_began = phase, now
+
+    def deadline(self) -> float:
+        return self.phase_began + (ENGINE_LIMIT if self.phase == "engine" else self._left)
+
+
+def _simplification_overran(task: RunTask, solved: Record, seconds: float) -> Record:
+    """The record of a run killed while simplifying its solution: its solve's own record (the
+    planner solved), with how long simplification ran and a note saying it did not return."""
+    record = dict(solved)
+    record["properties"] = {**solved["properties"], "simplification time REAL": seconds}
+    record["note"] = (
+        f"path simplification, bounded by the time limit of {task.time_limit:g} s, did not return within "
+        f"the run's hard limit of {task.hard_limit:g} s (2 x the time limit + the margin) and was killed after "
+        f"{seconds:.1f} s; the solve's results stand, the simplified path is not recorded"
+    )
+    return record
 
 
 def stop_runs(keys: Iterable[tuple[str, str, int]]) -> None:
