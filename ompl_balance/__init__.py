@@ -127,6 +127,8 @@ _LAZY = {
     "nearest_by_exhaustion": "policies",
     "node_quality": "policies",
     "path_length_objective": "rrtstar",
+    "setup_checker": "checking",
+    "CheckerError": "checking",
 }
 
 __all__ = [

@@ -15,15 +15,23 @@ reports), so the counts stay exact whichever engine, or a stock planner, did the
 A view's class names the module of its kernels (:func:`kernels_in`), so that the engine
 imports them, and numba, only when it compiles for such a view.
 
-A query a kernel cannot decide in compiled code (FCL on a non-convex pair, a user's
-Python callable) leaves through one exit: the kernel's ``objmode`` block looks the Python
-object up by the integer handle the view carries (:func:`exit_handle`) and calls it;
-each such call counts in ``counts[Count.EXITS]``.
+A query a kernel cannot decide in compiled code leaves through one exit, counted in
+``counts[Count.EXITS]``: FCL on a non-convex pair goes through the kernel's ``objmode`` block,
+which looks the Python object up by the integer handle the view carries (:func:`exit_handle`);
+a checker written in Python is called through a C callback
+(:mod:`ompl_balance.core.function_pointers`), once per motion rather than once per state.
+
+A check that raises (a user's function) cannot raise through compiled code: its kernel sets
+``counts[Count.RAISED]`` and answers "not valid"; the engine stops at once and has the object
+that kept the error raise it in Python.
 """
 
 from __future__ import annotations
 
+import ctypes
 import enum
+import functools
+import importlib
 import itertools
 import weakref
 from collections.abc import Callable
@@ -39,6 +47,7 @@ class Count(enum.IntEnum):
     MOTIONS = 1  # motions (edges) decided
     DISTANCE_QUERIES = 2  # exact distance queries of a certified motion validator
     EXITS = 3  # calls from compiled code to Python
+    RAISED = 4  # 1 while a check has raised and the error is not yet reported (see raised())
 
 
 def new_counts() -> np.ndarray:
@@ -63,7 +72,7 @@ def motion_free(view: Any, a: np.ndarray, b: np.ndarray) -> bool:
     raise TypeError("motion_free is a compiled kernel: call it from numba-compiled code with a checker's view")
 
 
-_TARGETS: weakref.WeakValueDictionary[int, Any] = weakref.WeakValueDictionary()  # handle -> object
+_TARGETS: dict[int, weakref.ref[Any]] = {}  # handle -> object, held weakly (its entry leaves with it)
 _HANDLE_OF: weakref.WeakKeyDictionary[Any, int] = weakref.WeakKeyDictionary()  # object -> handle
 _HANDLES = itertools.count(1)
 
@@ -74,14 +83,41 @@ def exit_handle(target: Any) -> int:
     handle = _HANDLE_OF.get(target)
     if handle is None:
         handle = next(_HANDLES)
-        _TARGETS[handle] = target
+        _TARGETS[handle] = weakref.ref(target, functools.partial(_forget, handle))
         _HANDLE_OF[target] = handle
     return handle
 
 
+def _forget(handle: int, reference: weakref.ref[Any]) -> None:
+    _TARGETS.pop(handle, None)
+
+
 def exit_target(handle: int) -> Any:
-    """The object registered under ``handle``, for a kernel's ``objmode`` block."""
-    return _TARGETS[handle]
+    """The object registered under ``handle``, for a kernel's exit (``KeyError`` once it is gone)."""
+    target = _TARGETS[handle]()
+    if target is None:
+        raise KeyError(handle)
+    return target
+
+
+#: C signature of an exit: ``int64 exit(int64 handle, int64 kind, int64 count)``.
+EXIT_SIGNATURE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64, ctypes.c_int64, ctypes.c_int64)
+
+
+def _exit(handle: int, kind: int, count: int) -> int:
+    """The exit's Python side: ``answer(kind, count)`` of the object behind ``handle``, or -1 with
+    the error kept in the object's ``error`` when it raised (an error cannot cross compiled code)."""
+    target = exit_target(handle)
+    try:
+        return int(target.answer(kind, count))
+    except BaseException as error:
+        target.error = error
+        return -1
+
+
+_EXIT = EXIT_SIGNATURE(_exit)  # kept for the life of the process
+#: Address of the exit (a C function pointer), for views to carry.
+EXIT_ADDRESS: int = ctypes.cast(_EXIT, ctypes.c_void_p).value or 0
 
 
 def exits_to_python(view: Any) -> bool:
@@ -119,3 +155,10 @@ def kernel_modules(view: Any) -> list[str]:
         if own is not None and own not in modules:
             modules.append(own)
     return modules
+
+
+def load_kernels(view: Any) -> None:
+    """Import the modules of the kernels of ``view`` and of the views inside it (registering them
+    with numba), as compiled code that takes ``view`` needs before it is compiled."""
+    for module in kernel_modules(view):
+        importlib.import_module(module)

@@ -23,11 +23,14 @@ decided by the same rule (counted by the validity checker).
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from types import FrameType
 from typing import Any
 
+import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -46,37 +49,59 @@ class CountingValidityChecker(ob.StateValidityChecker):
         is called) or a callable ``state -> bool``. A callable with a ``compiled_view(counts)``
         (the package's box worlds) also checks states for the compiled engine, which
         counts its states, and the motions it decides with OMPL's discrete rule, here too.
+
+    Attributes
+    ----------
+    check:
+        The check it counts, ``state -> bool`` (code that counts for itself, such as the
+        compiled engine's exits, calls it directly and adds to :attr:`counts`).
+    counts:
+        The counter compiled code and such callers add to, indexed by
+        :class:`~ompl_balance.core.checks.Count` (states and motions).
     """
 
     def __init__(self, si: ob.SpaceInformation, check: ob.StateValidityChecker | Callable[[ob.State], bool]):
         super().__init__(si)
-        self._check = check.isValid if isinstance(check, ob.StateValidityChecker) else check
-        self.states_checked = 0  # by isValid; compiled code counts in self._compiled_counts
-        self._compiled_counts = new_counts()
+        self.check: Callable[[ob.State], bool] = check.isValid if isinstance(check, ob.StateValidityChecker) else check
+        self.states_checked = 0  # by isValid; compiled code counts in self.counts
+        self.counts = new_counts()
         self._view: Any = None
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         self.states_checked += 1
-        return bool(self._check(state))
+        valid = self.check(state)
+        return valid if valid is True or valid is False else validity(valid, self.check)
 
     def compiled_view(self) -> Any:
         """The wrapped callable's compiled view (:mod:`ompl_balance.core.checks`), or ``None``."""
         if self._view is None:
-            view_of = getattr(self._check, "compiled_view", None)
-            self._view = False if view_of is None else view_of(self._compiled_counts)
+            view_of = getattr(self.check, "compiled_view", None)
+            self._view = False if view_of is None else view_of(self.counts)
         return self._view or None
 
     def counters(self) -> dict[str, int]:
         """States decided since construction or the last reset (by ``isValid`` and by compiled
         code) and the motions compiled code decided (OMPL's validator counts the others)."""
         return {
-            "states_checked": self.states_checked + int(self._compiled_counts[Count.STATES]),
-            "motions_checked": int(self._compiled_counts[Count.MOTIONS]),
+            "states_checked": self.states_checked + int(self.counts[Count.STATES]),
+            "motions_checked": int(self.counts[Count.MOTIONS]),
         }
 
     def reset_counters(self) -> None:
         self.states_checked = 0
-        self._compiled_counts[:] = 0
+        self.counts[:] = 0
+
+
+def validity(answer: Any, check: Callable[..., Any]) -> bool:
+    """A validity check's ``answer`` as a ``bool``: ``True``/``False``, or numpy's ``bool_``; anything
+    else (``None``, a number, an array) is refused with an error naming ``check`` and the answer."""
+    if isinstance(answer, (bool, np.bool_)):
+        return bool(answer)
+    name = getattr(check, "__qualname__", None) or type(check).__name__
+    raise TypeError(
+        f"the state validity checker {name} returned {answer!r} ({type(answer).__name__}); "
+        "a validity checker returns True or False"
+    )
 
 
 @dataclass(frozen=True)
@@ -102,13 +127,57 @@ def ensure_counting(si: ob.SpaceInformation) -> None:
     the same protocol) is left alone; any other checker, including the wrapper OMPL
     builds around a plain callable, is wrapped in a :class:`CountingValidityChecker`.
     Every planner using ``si`` afterwards (stock OMPL planners included) goes through
-    the counting checker, so their counts compare fairly.
+    the counting checker, so their counts compare fairly. Where the wrapped checker is
+    OMPL's wrapper of a Python function and the function can be told for sure
+    (:func:`installed_function`), the counting checker calls the function itself: one
+    call into Python per state instead of three crossings between Python and C++.
     """
     checker = si.getStateValidityChecker()
     if checker is None:
         raise ValueError("the space information has no state validity checker; call si.setStateValidityChecker first")
     if not hasattr(checker, "counters"):
-        si.setStateValidityChecker(CountingValidityChecker(si, checker))
+        function = installed_function(si, checker)
+        si.setStateValidityChecker(CountingValidityChecker(si, checker if function is None else function))
+
+
+#: Frames above the caller of :func:`installed_function` in which a ``SimpleSetup`` is looked for.
+_FRAMES_SEARCHED = 8
+
+
+def installed_function(si: ob.SpaceInformation, checker: ob.StateValidityChecker) -> Callable[..., Any] | None:
+    """The Python function ``checker`` calls, when ``checker`` is the one OMPL's bindings made
+    from it (``si.setStateValidityChecker(fn)`` or ``ss.setStateValidityChecker(fn)``); ``None``
+    when that cannot be told for sure.
+
+    OMPL 2.0's bindings keep the function a ``setStateValidityChecker`` call was given on the
+    object it was called on (``si`` or the ``SimpleSetup``, attribute ``_svc``), but not on the
+    checker. So the function is taken when exactly one function is found there: on ``si``, or
+    on a ``SimpleSetup`` of ``si`` held in a variable of one of the calling frames (a planner's
+    ``setup()`` runs inside ``ss.setup()`` or ``ss.solve()``). Two different ones (two
+    ``SimpleSetup`` of one ``si``, or a call on each) leave it undecided, and so does anything
+    else: the checker is then called as it is, with the same answers, only slower.
+    """
+    if type(checker) is not ob.StateValidityChecker:  # a checker written in Python, or a bound C++ class
+        return None
+    found = [_given_function(si)]
+    frame: FrameType | None = sys._getframe(1)
+    for _ in range(_FRAMES_SEARCHED):
+        if frame is None:
+            break
+        found += [_given_function(value) for value in frame.f_locals.values() if _is_simple_setup_of(value, si)]
+        frame = frame.f_back
+    functions = {id(function): function for function in found if function is not None}
+    return next(iter(functions.values())) if len(functions) == 1 else None
+
+
+def _given_function(owner: Any) -> Callable[..., Any] | None:
+    """The plain function the last ``setStateValidityChecker`` call on ``owner`` was given, if any."""
+    given = getattr(owner, "_svc", None)  # (where OMPL's bindings keep it)
+    return None if given is None or isinstance(given, ob.StateValidityChecker) or not callable(given) else given
+
+
+def _is_simple_setup_of(value: Any, si: ob.SpaceInformation) -> bool:
+    return isinstance(value, og.SimpleSetup) and value.getSpaceInformation() is si
 
 
 def read_work(si: ob.SpaceInformation) -> WorkCount:

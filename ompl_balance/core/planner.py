@@ -249,7 +249,13 @@ class TreePlanner(ob.Planner):
         # (how the last solve saw the space serves the next: allocating it costs a short solve's time)
         self._points = points_for(si, rng) if self._points is None else self._points.restarted(rng)
         self.progress = Progress()
-        status, measured = self._plan(ptc, self._points, rng)
+        try:
+            status, measured = self._plan(ptc, self._points, rng)
+        except Exception:
+            # An error mid-solve (a user's checker that raised) leaves the trees and OMPL's
+            # planner input states half-way (a goal state taken, not added): start afresh next time.
+            self.clear()
+            raise
         work = read_work(si) - work_before
         self.stats = self._statistics(ob.PlannerStatus(status).asString(), work, time.perf_counter() - began, measured)
         return ob.PlannerStatus(status)

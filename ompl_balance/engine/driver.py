@@ -290,6 +290,8 @@ def run(
                 elif stop == Stop.CONNECTED and solve.accept(int(ints[Slot.START_NODE]), int(ints[Slot.GOAL_NODE])):
                     status = ob.PlannerStatus.EXACT_SOLUTION
                     break
+                elif stop == Stop.RAISED:
+                    checks.raise_error()
         finally:
             arrays.adopt()
             _report(solve, arrays.loop, int(checks.view.counts[Count.EXITS]) - exits_before)

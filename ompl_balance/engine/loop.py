@@ -26,7 +26,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from .. import policies
-from ..core.checks import motion_free, state_free
+from ..core.checks import Count, motion_free, state_free
 from ..core.compiled_spaces import distance, equal, interpolate, row_distance, samples_from_uniforms, segment_count
 from ..core.kernel_cache import njit, njit_borrowing
 from ..core.layout import SpaceLayout
@@ -51,6 +51,7 @@ class Stop(enum.IntEnum):
     NEED_GOAL = 1  # the goal tree wants a goal state (fed by the caller, then GOAL_FED set)
     NEED_ROOM = 2  # a tree or the record has less room than one iteration may need
     CONNECTED = 3  # the trees connected: Slot.START_NODE, Slot.GOAL_NODE
+    RAISED = 4  # a check raised (checks.counts[Count.RAISED]): the caller reports the error
 
 
 class Slot(enum.IntEnum):
@@ -199,14 +200,14 @@ def _find_nearest(
     return (found, found_distance) if found != NO_NODE else (closest, closest_distance)
 
 
-@njit(cache=True)
+@njit_borrowing
 def _copy(source: np.ndarray, destination: np.ndarray) -> None:  # pragma: no cover (compiled)
     """``destination[:] = source`` as a loop (an array assignment compiles its shape checks' messages)."""
     for k in range(source.shape[0]):
         destination[k] = source[k]
 
 
-@njit(cache=True)
+@njit_borrowing
 def _add(tree: Tree, size: int, state: np.ndarray, parent: int) -> None:  # pragma: no cover (compiled)
     _copy(state, tree.states[size])
     tree.parents[size] = parent
@@ -242,7 +243,7 @@ def _node_towards(
     return given, distance(layout, trees[t].states[given], target)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _extend(
     checks: Any,
     layout: SpaceLayout,
@@ -434,6 +435,8 @@ def run(
         target = trees[o].states[0] if row == OTHER_ROOT else loop.block[row]
         node, gap = _node_towards(settings, layout, trees, loop, t, target, given)
         grown, added = _extend(checks, layout, settings, trees, loop, t, target, node, gap)
+        if checks.counts[Count.RAISED] != 0:
+            return Stop.RAISED
         if settings.record:
             _note_step(loop, _EXTENSION, t, node, given, grown, added, target)
         if grown == _TRAPPED:
@@ -445,6 +448,8 @@ def run(
         while connected == _ADVANCED:
             node, gap = _node_towards(settings, layout, trees, loop, o, reach, given)
             connected, reached = _extend(checks, layout, settings, trees, loop, o, reach, node, gap)
+            if checks.counts[Count.RAISED] != 0:
+                return Stop.RAISED
             if settings.record:
                 _note_step(loop, _CONNECT_STEP, o, node, given, connected, reached, reach)
             ints[Slot.STEPS] += 1

@@ -2,104 +2,108 @@
 
 Three kinds of check view (:mod:`ompl_balance.core.checks`), chosen by :func:`checks_for`:
 
-* a motion validator's own view (the package's robot validators): its kernels decide
-  states and motions;
-* :class:`DiscreteMotions`: OMPL's ``DiscreteMotionValidator`` (the default of a space
-  information; or a validator that says it ``checks_as_discrete``) around a validity checker's compiled view, as OMPL checks a motion: the end
-  state first, then the states at ``j / n`` of the way, ``n = validSegmentCount``, in
-  breadth-first bisection order;
-* :class:`PythonChecks`: anything else (a user's Python callable, a C++ checker, a motion
-  validator of their own): one call to ``si.isValid`` or ``si.checkMotion`` per query, on
-  two scratch OMPL states.
+* a motion validator's own view (the package's robot and rigid-body validators, and
+  :func:`~ompl_balance.checking.setup_checker`'s): its kernels decide states and motions;
+* :class:`~ompl_balance.core.discrete_motions.DiscreteMotions`: OMPL's ``DiscreteMotionValidator``
+  (the default of a space information; or a validator that says it ``checks_as_discrete``)
+  around a validity checker's compiled view, as OMPL checks a motion;
+* :class:`~ompl_balance.core.exit_checks.ExitChecks` answered by :class:`SpaceChecks`: anything
+  else (a user's Python callable, a C++ checker, a motion validator of their own), called from
+  compiled code through one exit: with OMPL's discrete validator and a checker the package
+  counts (a plain callable), all the states a motion tests in one call to Python, which checks
+  them in OMPL's order on a scratch OMPL state; otherwise one ``si.isValid`` or
+  ``si.checkMotion`` per query.
 
-The views are plain named tuples (this module does not import numba); their kernels are in
-:mod:`ompl_balance.engine.check_kernels`.
+This module does not import numba.
 """
 
 from __future__ import annotations
 
-import math
-from typing import Any, NamedTuple
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from ompl import base as ob
 
-from ..core.checks import exit_handle, exit_target, exits_to_python, kernels_in, new_counts
+from ..core.checks import Count, exits_to_python, new_counts
+from ..core.counting import CountingValidityChecker, validity
+from ..core.discrete_motions import discrete_motions
+from ..core.exit_checks import Query, exit_checks
 from ..core.layout import SpaceLayout
 
 
-@kernels_in("ompl_balance.engine.check_kernels")
-class DiscreteMotions(NamedTuple):
-    """OMPL's ``DiscreteMotionValidator`` around the compiled view ``states`` of a validity checker.
+class SpaceChecks:
+    """The target of the exits of a space information's checks: its checkers on flat states
+    (:class:`~ompl_balance.core.exit_checks.ExitChecks`; an error it raises is kept in :attr:`error`).
 
-    ``test`` (dim,) is scratch space and ``queue`` (rows, 2) the bisection's queue; the motions
-    count in ``counts`` (the validity checker's own counter, which also counts its states).
+    ``is_valid`` is the check called state by state (a counting checker's own check, or
+    ``si.isValid``); a state is written into the scratch OMPL state with one call of the
+    space's ``copyFromReals``.
     """
 
-    states: Any
-    layout: SpaceLayout
-    test: np.ndarray
-    queue: np.ndarray
-    counts: np.ndarray
-
-
-@kernels_in("ompl_balance.engine.check_kernels")
-class PythonChecks(NamedTuple):
-    """Checks by the space information: ``exit_target(handle)`` is a :class:`SpaceChecks`."""
-
-    handle: int
-    counts: np.ndarray  # calls out of compiled code (the checkers count their own work)
-
-
-class SpaceChecks:
-    """``si.isValid`` and ``si.checkMotion`` on flat states, through two scratch OMPL states."""
-
-    def __init__(self, si: ob.SpaceInformation) -> None:
+    def __init__(self, si: ob.SpaceInformation, is_valid: Callable[[ob.State], Any]) -> None:
+        self.error: BaseException | None = None
+        self.rows = np.empty((0, 0))  # the view's rows (set once the view is made)
         self._si = si
-        self._space = si.getStateSpace()
         self._scratch = (si.allocState(), si.allocState())
+        self._is_valid = is_valid
+        self._copy = si.getStateSpace().copyFromReals
 
-    def _state(self, q: np.ndarray, slot: int) -> ob.State:
-        state = self._scratch[slot]
-        self._space.copyFromReals(state, q.tolist())
-        return state
+    def answer(self, kind: int, count: int) -> int:
+        """The answer to query ``kind`` about ``rows[:count]`` (see :class:`~ompl_balance.core.exit_checks.Query`)."""
+        copy, rows = self._copy, self.rows
+        if kind == _STATES:
+            state, is_valid = self._scratch[0], self._is_valid
+            for index, values in enumerate(rows[:count].tolist()):
+                copy(state, values)
+                valid = is_valid(state)
+                if valid is not True and (valid is False or not validity(valid, is_valid)):
+                    return index
+            return count
+        start, end = self._scratch
+        copy(start, rows[0].tolist())
+        copy(end, rows[1].tolist())
+        return int(self._si.checkMotion(start, end))
 
-    def is_valid(self, q: np.ndarray) -> bool:
-        return bool(self._si.isValid(self._state(q, 0)))
-
-    def check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
-        return bool(self._si.checkMotion(self._state(a, 0), self._state(b, 1)))
-
-
-def call_is_valid(handle: int, q: np.ndarray) -> bool:
-    """``SpaceChecks.is_valid`` of the object behind ``handle`` (called from a kernel's objmode block)."""
-    return bool(exit_target(handle).is_valid(q))
+    def raise_error(self) -> None:
+        """Raise the error an exit kept, forgetting it."""
+        error, self.error = self.error, None
+        if error is not None:
+            raise error
 
 
-def call_check_motion(handle: int, a: np.ndarray, b: np.ndarray) -> bool:
-    """``SpaceChecks.check_motion`` of the object behind ``handle`` (called from a kernel's objmode block)."""
-    return bool(exit_target(handle).check_motion(a, b))
+_STATES = int(Query.STATES)
 
 
 class EngineChecks:
     """The check view of a solve and what it holds on to while the solve runs.
 
     ``path`` says how the checks are made: ``"kernel"`` (compiled kernels, leaving to Python
-    only for what they cannot decide) or ``"python"`` (``si.isValid``/``si.checkMotion``).
-    ``source``: the objects it was made from (validity checker, motion validator, their compiled
-    view, the layout), by identity. ``exits``: whether its kernels may call Python.
+    only for what they cannot decide) or ``"python"`` (the space information's checkers, called
+    through an exit). ``source``: the objects it was made from (validity checker, motion
+    validator, their compiled view, the layout), by identity. ``exits``: whether its kernels may
+    call Python through numba's ``objmode`` (see :func:`~ompl_balance.core.checks.exits_to_python`).
+    ``reporter``: the object that raises an error a check kept (its ``raise_error()``), if any.
     """
 
-    def __init__(self, view: Any, path: str, source: tuple[Any, ...], keep: Any = None) -> None:
+    def __init__(self, view: Any, path: str, source: tuple[Any, ...], reporter: Any = None) -> None:
         self.view = view
         self.path = path
         self.exits = exits_to_python(view)
         self.source = source
-        self.keep = keep  # the object behind the view's exit handle (held weakly by the registry)
+        self.reporter = reporter  # also keeps an exit's target alive (the registry holds it weakly)
 
     def made_from(self, source: tuple[Any, ...]) -> bool:
         """Whether these checks were made from the very objects ``source``."""
         return len(source) == len(self.source) and all(a is b for a, b in zip(source, self.source))
+
+    def raise_error(self) -> None:
+        """Raise the error a check kept while compiled code ran, if any (clearing its flag)."""
+        self.view.counts[Count.RAISED] = 0
+        raise_error = getattr(self.reporter, "raise_error", None)
+        if raise_error is not None:
+            raise_error()
+        raise RuntimeError("a validity check failed in compiled code and left no error to report")
 
 
 def checks_for(si: ob.SpaceInformation, layout: SpaceLayout, previous: EngineChecks | None = None) -> EngineChecks:
@@ -113,14 +117,15 @@ def checks_for(si: ob.SpaceInformation, layout: SpaceLayout, previous: EngineChe
     if previous is not None and previous.made_from(source):
         return previous
     if motions is not None:
-        return EngineChecks(motions, "kernel", source)
+        return EngineChecks(motions, "kernel", source, validator)
     # OMPL's own DiscreteMotionValidator, or one that checks the same states
     discrete = type(validator) is ob.MotionValidator or getattr(validator, "checks_as_discrete", False)
+    extent = si.getMaximumExtent()
     if states is not None and discrete:
-        # room for OMPL's bisection queue of a motion across the whole space
-        longest = max(int(f) * math.ceil(si.getMaximumExtent() / g) for f, g in zip(layout.factor, layout.segment))
-        queue = np.empty((2 * longest + 4, 2), dtype=np.int64)
-        view = DiscreteMotions(states, layout, np.empty(layout.dim), queue, states.counts)
-        return EngineChecks(view, "kernel", source)
-    space_checks = SpaceChecks(si)
-    return EngineChecks(PythonChecks(exit_handle(space_checks), new_counts()), "python", source, space_checks)
+        return EngineChecks(discrete_motions(states, layout, extent), "kernel", source, checker)
+    # A checker the package counts (a plain callable): a motion's states in one exit, counted here.
+    batched = discrete and isinstance(checker, CountingValidityChecker)
+    space_checks = SpaceChecks(si, checker.check if batched else si.isValid)
+    exits = exit_checks(space_checks, layout, extent, checker.counts if batched else new_counts(), batched)
+    space_checks.rows = exits.rows
+    return EngineChecks(exits, "python", source, space_checks)

@@ -1,0 +1,71 @@
+"""The compiled kernels of :class:`~ompl_balance.core.discrete_motions.DiscreteMotions`, and the order
+in which OMPL's discrete rule tests a motion's states (:func:`bisection_order`), which every
+kernel checking a motion by that rule takes."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .check_overloads import register_kernels
+from .checks import Count, state_free
+from .compiled_spaces import interpolate, segment_count
+from .discrete_motions import DiscreteMotions
+from .kernel_cache import njit, njit_borrowing
+
+
+@njit_borrowing
+def bisection_order(n: int, queue: np.ndarray, order: np.ndarray) -> None:  # pragma: no cover (compiled)
+    """Write ``j = 1 .. n - 1`` into ``order[:n - 1]`` in the order OMPL tests the states at ``j / n``.
+
+    ``queue`` (rows, 2) holds the pending index ranges, a ring in which a range leaves before its
+    two halves enter, so ``n`` rows always suffice; ``queue`` and ``order`` must have at least
+    ``n`` rows (callers size them for the longest motion of their space, and make larger ones
+    for a longer motion).
+    """
+    if n < 2:
+        return
+    head, tail, out = 0, 1, 0
+    queue[0, 0], queue[0, 1] = 1, n - 1
+    while head != tail:
+        first, last = queue[head, 0], queue[head, 1]
+        head = (head + 1) % queue.shape[0]
+        middle = (first + last) // 2
+        order[out] = middle
+        out += 1
+        if first < middle:
+            queue[tail, 0], queue[tail, 1] = first, middle - 1
+            tail = (tail + 1) % queue.shape[0]
+        if last > middle:
+            queue[tail, 0], queue[tail, 1] = middle + 1, last
+            tail = (tail + 1) % queue.shape[0]
+
+
+@njit(cache=True)
+def discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
+    """OMPL's ``DiscreteMotionValidator::checkMotion(a, b)`` with the state kernel of ``view.states``:
+    ``b``, then the states between in its order (:mod:`ompl_balance.core.discrete_motions`) until
+    the first invalid one. (The view's fields read once, first, as
+    :func:`~ompl_balance.worlds.box_kernels.box_state_free` does.)"""
+    states, layout, test, queue, order = view.states, view.layout, view.test, view.queue, view.order
+    view.counts[Count.MOTIONS] += 1
+    if not state_free(states, b):
+        return False
+    n = segment_count(layout, a, b)
+    if n < 2:
+        return True
+    if order.shape[0] < n:  # a motion longer than the scratch was sized for
+        queue, order = np.empty((n, 2), dtype=np.int64), np.empty(n, dtype=np.int64)
+    bisection_order(n, queue, order)
+    for k in range(n - 1):
+        interpolate(layout, a, b, order[k] / n, test)
+        if not state_free(states, test):
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def discrete_state_free(view: DiscreteMotions, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    return state_free(view.states, q)
+
+
+register_kernels(DiscreteMotions, state=discrete_state_free, motion=discrete_motion_free)

@@ -1,0 +1,67 @@
+"""Checks made in Python for compiled code, a motion's states in one call: the exit check view.
+
+A checker written in Python (a user's function of OMPL states or of coordinates, a vectorized
+numpy function) cannot be called from compiled code directly. :class:`ExitChecks` is the
+view the compiled engine calls it through (:mod:`ompl_balance.core.checks`): its kernels
+write the states a query is about into :attr:`ExitChecks.rows` and make one exit to Python
+(:data:`~ompl_balance.core.checks.EXIT_ADDRESS`), where the object registered as its
+``target`` answers. With ``batched`` a motion checked by OMPL's discrete rule goes to Python
+once, with all the states ``DiscreteMotionValidator::checkMotion`` would test, in its order
+(:mod:`ompl_balance.core.discrete_motions`); the target tests them in that order until the
+first invalid one, so the answer, and the states tested, are OMPL's. Without ``batched``
+each query is its own exit (``si.isValid`` or ``si.checkMotion``, for a motion validator of
+the user's own).
+
+A target answers ``answer(kind, count)`` (:class:`Query`); an error it raises is kept in its
+``error`` and raised again by its ``raise_error()`` once the compiled code has returned.
+
+The view is a plain named tuple (this module does not import numba); its kernels are in
+:mod:`ompl_balance.core.exit_check_kernels`.
+"""
+
+from __future__ import annotations
+
+import enum
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from .checks import EXIT_ADDRESS, exit_handle, kernels_in
+from .discrete_motions import bisection_scratch
+from .layout import SpaceLayout
+
+
+class Query(enum.IntEnum):
+    """What an exit of :class:`ExitChecks` asks its target (its ``kind``)."""
+
+    STATES = 0  # the index of the first invalid state of rows[:count] in order (count: all valid)
+    MOTION = 1  # whether the motion rows[0] -> rows[1] is valid: 1 valid, 0 not
+
+
+@kernels_in("ompl_balance.core.exit_check_kernels")
+class ExitChecks(NamedTuple):
+    """Checks by the Python object registered under handle ``target``, through the exit at
+    ``address`` (see the module docstring).
+
+    ``rows`` (capacity, dim) holds the states a query is about, written by compiled code and
+    read by the target; ``queue`` (capacity, 2) and ``order`` (capacity,) are the bisection's
+    scratch; ``counts`` the work counter (batched: states and motions; always: exits).
+    """
+
+    address: int
+    target: int
+    layout: SpaceLayout
+    rows: np.ndarray
+    queue: np.ndarray
+    order: np.ndarray
+    counts: np.ndarray
+    batched: bool
+
+
+def exit_checks(target: Any, layout: SpaceLayout, extent: float, counts: np.ndarray, batched: bool) -> ExitChecks:
+    """The :class:`ExitChecks` of ``target`` (an object with ``answer`` and ``error``) in a space of
+    ``layout`` and maximum extent ``extent``, counting in ``counts``; rows for the longest motion
+    when ``batched`` (a longer one goes to Python in parts), else for two states."""
+    queue, order = bisection_scratch(extent, layout)
+    rows = np.empty((len(order) if batched else 2, layout.dim))
+    return ExitChecks(EXIT_ADDRESS, exit_handle(target), layout, rows, queue, order, counts, batched)

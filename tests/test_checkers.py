@@ -1,0 +1,526 @@
+"""Your own checker: setup_checker's kinds of function, and plain callables, on both engines and stock.
+
+Oracles: the Python engine on the same seed (the same trees, paths and counts), OMPL's own
+``DiscreteMotionValidator`` (the same answers and the same states tested), a brute-force
+re-check of OMPL's lastValid rule, and the function's own calls.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import re
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+
+import numba
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+from test_engine import assert_same_run, solve
+
+from ompl_balance import BalancedRRTConnect, setup_checker
+from ompl_balance.checking import CheckerError, FunctionMotionValidator, FunctionValidityChecker
+from ompl_balance.core.counting import CountingValidityChecker
+
+ou.setLogLevel(ou.LOG_WARN)
+
+#: Three staggered walls between the start (0.05, 0.05) and the goal (0.95, 0.95) of the unit square.
+WALLS = np.array([(0.2, 0.0, 0.25, 0.85), (0.45, 0.15, 0.5, 1.0), (0.7, 0.0, 0.75, 0.85)])
+
+
+def python_free(q):
+    return all(not (x0 <= q[0] <= x1 and y0 <= q[1] <= y1) for x0, y0, x1, y1 in WALLS.tolist())
+
+
+@numba.njit(cache=True)
+def numba_free(q):
+    for i in range(WALLS.shape[0]):
+        if WALLS[i, 0] <= q[0] <= WALLS[i, 2] and WALLS[i, 1] <= q[1] <= WALLS[i, 3]:
+            return False
+    return True
+
+
+def vectorized_free(states):
+    x, y = states[:, :1], states[:, 1:2]
+    inside = (WALLS[:, 0] <= x) & (x <= WALLS[:, 2]) & (WALLS[:, 1] <= y) & (y <= WALLS[:, 3])
+    return ~inside.any(axis=1)
+
+
+def state_free(state) -> bool:
+    """The same test as a plain callable of an OMPL state."""
+    return python_free((state[0], state[1]))
+
+
+KINDS = {
+    "python": (python_free, False),
+    "numba": (numba_free, False),
+    "vectorized": (vectorized_free, True),
+}
+
+
+def square(function=None, vectorized=False, plain=None, space=None):
+    """The unit square (or ``space``) with ``function`` through setup_checker, or ``plain`` as
+    ``ss.setStateValidityChecker(plain)``; start (0.05, 0.05), goal (0.95, 0.95)."""
+    if space is None:
+        space = ob.RealVectorStateSpace(2)
+        space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    if plain is not None:
+        ss.setStateValidityChecker(plain)
+    else:
+        setup_checker(ss, function, vectorized=vectorized)
+    start, goal = space.allocState(), space.allocState()
+    start[0], start[1], goal[0], goal[1] = 0.05, 0.05, 0.95, 0.95
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
+def make(kind):
+    function, vectorized = KINDS[kind]
+    return lambda: square(function, vectorized)
+
+
+# -- the same trees --------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_each_kind_of_function_makes_the_same_trees_on_both_engines(kind):
+    python = solve(make(kind), "python", seed=5, solves=2)
+    compiled = solve(make(kind), "compiled", seed=5, solves=2)
+    assert python[0][0] == "Exact solution"
+    assert_same_run(python, compiled)
+
+
+def test_a_numba_function_and_the_same_test_as_a_plain_callable_make_the_same_trees():
+    """The package's planner on a seed: a numba function through setup_checker (compiled, no
+    Python per state) and the same test as ``ss.setStateValidityChecker(fn)`` (one call into
+    Python per motion) make the same trees, paths and counts, on either engine."""
+    runs = [
+        solve(make("numba"), "compiled", seed=9),
+        solve(lambda: square(plain=state_free), "compiled", seed=9),
+        solve(lambda: square(plain=state_free), "python", seed=9),
+    ]
+    for other in runs[1:]:
+        assert_same_run(runs[0], other)
+
+
+def test_the_compiled_engine_calls_python_once_per_motion_for_a_plain_callable():
+    """Every check of a plain callable is made in Python, a motion's states in one call: the calls
+    out of compiled code are the motions plus the goal tree's new states, and fewer than the
+    states; a numba function makes none."""
+    ss = square(plain=state_free)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    planner.setSeed(2)
+    ss.setPlanner(planner)
+    assert ss.solve(10.0)
+    stats = planner.stats
+    assert (stats.engine, stats.checks) == ("compiled", "python")
+    assert stats.motions_checked <= stats.exits < stats.states_checked
+    ss = make("numba")()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    ss.setPlanner(planner)
+    assert ss.solve(10.0)
+    assert (planner.stats.checks, planner.stats.exits) == ("kernel", 0)
+
+
+def test_a_plain_callable_is_called_directly_and_ambiguity_keeps_ompls_checker():
+    """``ss.setStateValidityChecker(fn)``: the counting checker the package installs calls ``fn``
+    itself. Two SimpleSetups of one space information given different functions leave it unsure
+    which is installed: then it calls OMPL's checker as it is."""
+    ss = square(plain=state_free)
+    ss.setPlanner(BalancedRRTConnect(ss.getSpaceInformation()))
+    ss.setup()
+    checker = ss.getSpaceInformation().getStateValidityChecker()
+    assert isinstance(checker, CountingValidityChecker) and checker.check is state_free
+    ss = square(plain=state_free)
+    other = og.SimpleSetup(ss.getSpaceInformation())
+    other.setStateValidityChecker(lambda state: not state_free(state))  # installed last: the one OMPL calls
+    ss.setPlanner(BalancedRRTConnect(ss.getSpaceInformation()))
+    ss.setup()
+    checker = ss.getSpaceInformation().getStateValidityChecker()
+    assert checker.check is not state_free
+    state = ss.getSpaceInformation().allocState()
+    state[0], state[1] = 0.22, 0.5  # inside the first wall: the installed (inverted) checker says valid
+    assert checker.isValid(state) is True
+
+
+# -- OMPL's discrete rule -----------------------------------------------------------------------------
+
+
+def ompl_reference(function_of_state):
+    """A space information with ``function_of_state`` and OMPL's own DiscreteMotionValidator, and
+    the function's call count."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    si = ob.SpaceInformation(space)
+    calls = [0]
+
+    def counted(state):
+        calls[0] += 1
+        return function_of_state(state)
+
+    si.setStateValidityChecker(counted)
+    si.setStateValidityCheckingResolution(0.01)
+    si.setup()
+    return si, calls
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_motions_get_ompls_answers_and_test_as_many_states(kind):
+    """On 300 random motions (short and across the square): the same answers as OMPL's
+    DiscreteMotionValidator with the same test, and as many states tested (OMPL's calls)."""
+    reference, calls = ompl_reference(state_free)
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    si = ob.SpaceInformation(space)
+    function, vectorized = KINDS[kind]
+    checker, validator = setup_checker(si, function, vectorized=vectorized)
+    si.setStateValidityCheckingResolution(0.01)
+    si.setup()
+    rng = np.random.default_rng(4)
+    a, b = si.allocState(), si.allocState()
+    ra, rb = reference.allocState(), reference.allocState()
+    answers = []
+    for index in range(300):
+        p, q = rng.random(2), rng.random(2)
+        if index % 2:
+            q = p + 0.05 * (q - p)  # a short motion too
+        for state, other, values in ((a, ra, p), (b, rb, q)):
+            state[0], state[1] = other[0], other[1] = values
+        before, counted = calls[0], checker.counters()["states_checked"]
+        answer = validator.checkMotion(a, b)
+        assert answer == reference.checkMotion(ra, rb), (p, q)
+        assert checker.counters()["states_checked"] - counted == calls[0] - before
+        answers.append(answer)
+    assert 0 < sum(answers) < len(answers)  # both kinds of answer were given
+    assert validator.counters()["motions_checked"] == 300
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_last_valid_follows_ompls_rule(kind):
+    """``check_motion_last_valid``: the states from s1 outwards at j / n, then s2; the fraction of
+    the last valid one, brute force with the same function."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    si = ob.SpaceInformation(space)
+    function, vectorized = KINDS[kind]
+    _, validator = setup_checker(si, function, vectorized=vectorized)
+    si.setup()
+    rng = np.random.default_rng(6)
+    a, b = si.allocState(), si.allocState()
+    for _ in range(100):
+        p, q = rng.random(2), rng.random(2)
+        p = np.array([0.1, p[1]]) if python_free(p) is False else p
+        a[0], a[1], b[0], b[1] = *p, *q
+        n = space.validSegmentCount(a, b)
+        expected = (True, 1.0)
+        for j in range(1, n + 1):
+            if not python_free(p + (j / n) * (q - p)):
+                expected = (False, (j - 1) / n)
+                break
+        valid, fraction = validator.check_motion_last_valid(a, b)
+        assert valid == expected[0]
+        assert fraction == pytest.approx(expected[1])
+
+
+def test_the_flat_layout_of_se2_and_a_compound_space_reaches_the_function():
+    """The function gets OMPL's copyFromReals order: (x, y, yaw) for SE(2), then a compound's
+    second subspace."""
+    seen = []
+
+    def record(q):
+        seen.append(q.copy())
+        return True
+
+    space = ob.CompoundStateSpace()
+    se2 = ob.SE2StateSpace()
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(-1.0)
+    bounds.setHigh(1.0)
+    se2.setBounds(bounds)
+    line = ob.RealVectorStateSpace(1)
+    line.setBounds(0.0, 2.0)
+    space.addSubspace(se2, 1.0)
+    space.addSubspace(line, 1.0)
+    si = ob.SpaceInformation(space)
+    checker, _ = setup_checker(si, record)
+    si.setup()
+    state = si.allocState()
+    space.copyFromReals(state, [0.25, -0.5, 1.5, 1.75])
+    assert checker.isValid(state)
+    np.testing.assert_array_equal(seen[-1], [0.25, -0.5, 1.5, 1.75])
+
+
+# -- errors ---------------------------------------------------------------------------------------------
+
+_RAISE = [True]
+
+
+def raising_python(q):
+    if _RAISE[0] and q[0] > 0.5:
+        raise ValueError("the test's own error")
+    return True
+
+
+@numba.njit
+def raising_numba(q):
+    if q[0] > 0.5 and q[1] > -10.0:  # (numba cannot read the module's flag: always raises there)
+        raise ValueError("the test's own error")
+    return True
+
+
+def raising_vectorized(states):
+    if _RAISE[0] and (states[:, 0] > 0.5).any():
+        raise ValueError("the test's own error")
+    return np.ones(len(states), dtype=bool)
+
+
+@pytest.mark.parametrize(
+    ("function", "vectorized"),
+    [(raising_python, False), (raising_numba, False), (raising_vectorized, True)],
+    ids=["python", "numba", "vectorized"],
+)
+@pytest.mark.parametrize("engine", ["python", "compiled", "stock"])
+def test_a_function_that_raises_gives_an_error_naming_it(function, vectorized, engine):
+    """The error names the function and says what it raised, on both engines and under a stock
+    planner; the package's planner then solves again (once the function no longer raises)."""
+    _RAISE[0] = True
+    ss = square(function, vectorized)
+    si = ss.getSpaceInformation()
+    planner = og.RRTConnect(si) if engine == "stock" else BalancedRRTConnect(si)
+    if engine != "stock":
+        planner.setEngine(engine)
+    ss.setPlanner(planner)
+    with pytest.raises(CheckerError, match=rf"{function.__name__}.*ValueError.*the test's own error"):
+        ss.solve(5.0)
+    if engine == "stock" or function is raising_numba:
+        return
+    _RAISE[0] = False
+    try:
+        assert ss.solve(5.0)
+        path = ss.getSolutionPath()
+        assert path.check()
+    finally:
+        _RAISE[0] = True
+
+
+def test_the_planner_solves_on_after_a_numba_function_raised():
+    """A numba function that raises where the first solve goes: the error, then a fresh problem
+    for the same planner object (cleared) solves, its compiled engine reused."""
+
+    @numba.njit
+    def walls_that_raise_beyond(q):
+        if q[0] > 2.0:
+            raise ValueError("outside")
+        return numba_free(q)
+
+    ss = square(walls_that_raise_beyond)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    ss.setPlanner(planner)
+    assert ss.solve(10.0)
+    checker = ss.getSpaceInformation().getStateValidityChecker()
+    state = ss.getSpaceInformation().allocState()
+    state[0], state[1] = 3.0, 0.5
+    with pytest.raises(CheckerError, match=r"walls_that_raise_beyond.*outside"):
+        checker.isValid(state)
+    ss.clear()
+    assert ss.solve(10.0)
+
+
+@pytest.mark.parametrize(
+    ("returned", "accepted"),
+    [(np.bool_(True), True), (None, False), (np.float64(1.0), False), (1, False)],
+)
+def test_a_plain_callables_answer_must_be_a_bool(returned, accepted):
+    """numpy's bool is taken as Python's; anything else is refused with an error naming the
+    function and what it returned (OMPL's own binding says only std::bad_cast)."""
+
+    def answers_oddly(state):
+        return returned
+
+    ss = square(plain=answers_oddly)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    if accepted:
+        assert ss.solve(1.0)
+    else:
+        with pytest.raises(TypeError, match=rf"answers_oddly returned {re.escape(repr(returned))}.*True or False"):
+            ss.solve(1.0)
+
+
+def test_setup_checker_refuses_what_it_cannot_take():
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    si = ob.SpaceInformation(space)
+    cases = [
+        (42, {}, TypeError, "fn must be a function"),
+        (lambda: True, {}, TypeError, "must take one argument"),
+        (lambda q, extra: True, {}, TypeError, "must take one argument"),
+        (numba.njit(lambda q: q[0]), {}, TypeError, "returns float64; a validity function returns a bool"),
+        (numba_free, {"vectorized": True}, TypeError, "vectorized=True takes a numpy function"),
+    ]
+    for function, options, error, message in cases:
+        with pytest.raises(error, match=message):
+            setup_checker(si, function, **options)
+    with pytest.raises(TypeError, match=r"SpaceInformation or an ompl\.geometric\.SimpleSetup"):
+        setup_checker(space, python_free)
+    unbounded = ob.SpaceInformation(ob.RealVectorStateSpace(2))
+    with pytest.raises(ValueError, match="bounds are not set"):
+        setup_checker(unbounded, python_free)
+    discrete = ob.DiscreteStateSpace(0, 5)
+    with pytest.raises(ValueError, match="no flat layout"):
+        setup_checker(ob.SpaceInformation(discrete), python_free)
+
+
+@pytest.mark.parametrize(
+    ("returned", "message"),
+    [
+        (lambda states: np.ones(len(states) + 1, dtype=bool), r"shape \(\d+,\) and dtype bool for \d+ states"),
+        (lambda states: np.ones(len(states)), "dtype float64"),
+        (lambda states: [True] * len(states), "returned list"),
+    ],
+    ids=["shape", "dtype", "list"],
+)
+def test_a_vectorized_function_of_the_wrong_shape_or_dtype_is_refused(returned, message):
+    ss = square(returned, vectorized=True)
+    ss.setPlanner(BalancedRRTConnect(ss.getSpaceInformation()))
+    with pytest.raises(CheckerError, match=message):
+        ss.solve(1.0)
+
+
+def test_a_cfunc_is_called_as_it_is():
+    signature = numba.types.boolean(numba.types.CPointer(numba.types.float64), numba.types.intp)
+
+    @numba.cfunc(signature)
+    def free(values, dim):
+        return numba.carray(values, (dim,))[0] < 0.99  # the goal's column is free
+
+    ss = square(free)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    ss.setPlanner(planner)
+    assert ss.solve(5.0)
+    assert (planner.stats.checks, planner.stats.exits) == ("kernel", 0)
+    wrong = numba.cfunc(numba.types.float64(numba.types.float64))(lambda x: x)
+    with pytest.raises(TypeError, match="boolean\\(CPointer\\(float64\\), intp\\)"):
+        setup_checker(ss, wrong)
+
+
+# -- concurrency, repetition, Ctrl-C ---------------------------------------------------------------------
+
+
+def test_two_planners_in_two_threads_with_their_own_functions():
+    """Two compiled solves at once, one numba function each (the walls, and the walls mirrored):
+    each path is valid for its own function alone."""
+
+    @numba.njit
+    def mirrored(q):
+        return numba_free(np.array([q[1], q[0]]))
+
+    setups = [make("numba")(), square(mirrored)]
+    results: list[object] = [None, None]
+
+    def run(index):
+        ss = setups[index]
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        planner.setEngine("compiled")
+        planner.setSeed(index + 1)
+        ss.setPlanner(planner)
+        ss.setup()
+        planner.wait_for_engine()
+        results[index] = ss.solve(10.0)
+
+    threads = [threading.Thread(target=run, args=(index,)) for index in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert all(results)
+    for ss, function in ((setups[0], numba_free), (setups[1], mirrored)):
+        path = ss.getSolutionPath()
+        path.interpolate(200)
+        for i in range(path.getStateCount()):
+            state = path.getState(i)
+            assert function(np.array([state[0], state[1]]))
+
+
+def test_repeated_solves_and_clear():
+    """Solves without clear() grow the same trees on both engines; clear() starts afresh (the
+    counters count each solve's work)."""
+    between = (lambda ss, planner: None, lambda ss, planner: ss.clear())
+    python = solve(make("numba"), "python", seed=4, solves=3, between=between)
+    compiled = solve(make("numba"), "compiled", seed=4, solves=3, between=between)
+    assert_same_run(python, compiled)
+
+
+def test_ctrl_c_during_a_solve_with_a_numba_function():
+    script = textwrap.dedent(
+        """
+        import signal, sys
+        import numba, numpy as np
+        from ompl import util as ou
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        ou.setLogLevel(ou.LOG_WARN)
+        sys.path.insert(0, "tests")
+        from test_checkers import square
+        from ompl_balance import BalancedRRTConnect
+
+        @numba.njit
+        def wall(q):
+            return not (0.4 <= q[0] <= 0.6)  # across the square: no solve ends
+
+        ss = square(wall)
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        planner.setEngine("compiled")
+        ss.setPlanner(planner)
+        ss.setup()
+        planner.wait_for_engine()
+        print("solving", flush=True)
+        try:
+            planner.solve(60.0)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+        print("again", bool(planner.solve(0.2)) is False, flush=True)
+        """
+    )
+    process = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    assert process.stdout is not None
+    assert process.stdout.readline().strip() == "solving"
+    time.sleep(1.0)
+    process.send_signal(signal.SIGINT)
+    began = time.perf_counter()
+    out, err = process.communicate(timeout=60)
+    assert "interrupted" in out and "again True" in out, err[-3000:]
+    assert time.perf_counter() - began < 20.0
+
+
+def test_stock_planners_get_the_same_paths_checked():
+    """A stock planner with setup_checker's checker and validator: its path is valid under a dense
+    re-check with the function (OMPL's rule through the package's validator)."""
+    for kind in KINDS:
+        ss = make(kind)()
+        ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+        assert ss.solve(10.0)
+        path = ss.getSolutionPath()
+        states = [np.array([path.getState(i)[0], path.getState(i)[1]]) for i in range(path.getStateCount())]
+        for a, b in itertools.pairwise(states):
+            steps = max(2, math.ceil(np.linalg.norm(b - a) / 0.001))
+            assert all(python_free(a + t * (b - a)) for t in np.linspace(0.0, 1.0, steps)), kind
+
+
+def test_the_installed_objects_are_ompls_classes():
+    checker, validator = setup_checker(square(numba_free).getSpaceInformation(), numba_free)
+    assert isinstance(checker, (FunctionValidityChecker, ob.StateValidityChecker))
+    assert isinstance(validator, (FunctionMotionValidator, ob.MotionValidator))
