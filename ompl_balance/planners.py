@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from functools import partial
 from typing import Any, ClassVar
 
 import numpy as np
@@ -35,116 +34,22 @@ from ompl import util as ou
 
 from .core.counting import WorkCount
 from .core.layout import has_layout
-from .core.params import Settings, param
 from .core.planner import GOAL_TAG, RANGE_AS_EXTENT_FRACTION, START_TAG, PlannerSpecs, TreePlanner
 from .core.spaces import ArrayPoints, Points
 from .core.trees import NO_PARENT, Tree
 from .engine import python_loop
 from .engine.compiled import CompiledEngine, CompiledRun, room_per_iteration
 from .engine.events import LoopCounts, LoopRecord
-from .engine.solve import LoopPolicies, Solve
-from .policies import (
-    NEAREST_POLICIES,
-    SAMPLE_POLICIES,
-    SWAP_POLICIES,
-    NodeFailures,
-    SampleContext,
-    SamplerCounts,
-    SwapCause,
-    SwapState,
-    TreeChoice,
-    nearest_choice,
-    target_choice,
-)
+from .engine.settings import RRTConnectSettings
+from .engine.solve import Solve
+from .policies import NodeFailures, SamplerCounts, SwapCause, SwapState
 from .samplers import PassageSampler
 
 #: ``allocate(si) -> ob.ValidStateSampler`` (a valid-state sampler class is one).
 ValidStateSamplerAllocator = Callable[[Any], Any]
 
-#: ``engine`` choices: the compiled engine where it applies (else Python), always compiled, always Python.
-ENGINES = ("auto", "compiled", "python")
 #: Nodes one iteration may add beyond which a solve stays on the Python engine (a tiny ``range``).
 MAX_ROOM = 1 << 20
-
-
-@dataclass
-class RRTConnectSettings(Settings):
-    """The parameters of :class:`BalancedRRTConnect` (OMPL names; distances in the space's units)."""
-
-    range: float = param(
-        0.0,
-        "longest motion added to a tree in one step; 0 picks 0.2 x the space's maximum extent at setup()",
-        low=0.0,
-        suggestion="0.:1.:10000.",
-    )
-    intermediate_states: bool = param(
-        False,
-        "add the states along each motion (at the validity-checking resolution) to the tree, "
-        "as OMPL's RRTConnect with addIntermediateStates",
-    )
-    balance_tree_sizes: bool = param(
-        True,
-        "grow the smaller tree once |a - b| / min(a, b) reaches max_tree_size_ratio (a, b the tree sizes); "
-        "otherwise swap_policy decides",
-    )
-    max_tree_size_ratio: float = param(
-        1.0,
-        "the balancing rule's ratio; 1.0 grows the smaller tree once it is less than half the size of the other",
-        low=0.0,
-        suggestion="0.:0.05:10.",
-    )
-    swap_policy: str = param(
-        "alternate",
-        "which tree grows when balancing does not decide: the other one each iteration (stock), "
-        "the same one until swap_steps connect steps were taken, or until a connect collides",
-        choices=SWAP_POLICIES,
-    )
-    swap_steps: int = param(10, "connect steps after which balance_steps swaps trees", low=1, suggestion="1:1:100")
-    nearest_policy: str = param(
-        "euclidean",
-        "the node a tree grows from: the nearest (the space's metric), the nearest not exhausted "
-        "(exhausted_after), or the least distance x exhaustion scale (exhaustion_target)",
-        choices=NEAREST_POLICIES,
-    )
-    exhausted_after: int = param(15, "failed extensions after which a node is exhausted", low=1, suggestion="1:1:100")
-    exhaustion_target: int = param(
-        5, "failures at which the exhaustion scale is lowest (0.9)", low=1, suggestion="1:1:100"
-    )
-    sample_policy: str = param(
-        "uniform",
-        "where each iteration's target comes from (see ompl_balance.policies.target_choice)",
-        choices=SAMPLE_POLICIES,
-    )
-    goal_bias: float = param(
-        0.05, "probability that goal_bias targets the other tree's root", low=0.0, high=1.0, suggestion="0.:.05:1."
-    )
-    uniform_rate: float = param(
-        0.1,
-        "probability that an iteration of goal_ball, neighbour_quality or valid_sampler targets a uniform sample "
-        "of the whole space instead, which keeps those policies probabilistically complete; 0: their targets "
-        "only (the strict rules)",
-        low=0.0,
-        high=1.0,
-        suggestion="0.:.05:1.",
-    )
-    min_quality: float = param(
-        0.0, "lowest acceptance probability of neighbour_quality", low=0.0, high=1.0, suggestion="0.:.05:1."
-    )
-    seed: int = param(
-        0,
-        "0: each solve draws its seed from an OMPL RNG (repeated by ompl.util.RNG.setSeed); > 0: every solve "
-        "uses this seed (real-vector, SO(2), SO(3), SE(2), SE(3) spaces and their compounds; other spaces "
-        "sample with OMPL's sampler and seed)",
-        low=0,
-        suggestion="0:1:1000000",
-    )
-    engine: str = param(
-        "auto",
-        "the loop's implementation: compiled (numba; the spaces seed names, every sample_policy but "
-        "valid_sampler, the package's checkers called as compiled kernels), python (any space and policy), "
-        "or auto: compiled where it applies and is loaded, else python (the same trees in real-vector spaces)",
-        choices=ENGINES,
-    )
 
 
 @dataclass
@@ -421,58 +326,26 @@ class BalancedRRTConnect(TreePlanner):
         return result(status, solve, engine, checks)
 
     def _solve(self, points: Points, rng: np.random.Generator, inputs: ob.PlannerInputStates, goal: Any) -> Solve:
-        """This solve around the planner's trees (its policies made only if the Python engine runs it)."""
+        """This solve around the planner's trees."""
         assert self._start_tree is not None and self._goal_tree is not None
-        sampler_counts = SamplerCounts()
+        settings = self.settings
         return Solve(
             name=self.getName(),
             si=self.getSpaceInformation(),
             points=points,
-            settings=self.settings,
+            settings=settings,
             start_tree=self._start_tree,
             goal_tree=self._goal_tree,
             failures=self._failures,
             swap_state=self._swap_state,
-            policies=partial(self._policies, points, rng, sampler_counts),
             inputs=inputs,
             goal=goal,
             progress=self.progress,
             rng=rng,
             record=self.loop_record,
+            valid_sampler=self._valid_state_sampler() if settings.sample_policy == "valid_sampler" else None,
             tree_gap=self._distance_between_trees,
-            sampler_counts=sampler_counts,
         )
-
-    def _policies(self, points: Points, rng: np.random.Generator, sampler_counts: SamplerCounts) -> LoopPolicies:
-        """A solve's policies as objects, for the Python engine."""
-        settings = self.settings
-        assert self._start_tree is not None and self._goal_tree is not None
-        tree_choice = TreeChoice(
-            settings.swap_policy,
-            self._swap_state,
-            settings.balance_tree_sizes,
-            settings.max_tree_size_ratio,
-            settings.swap_steps,
-        )
-        nearest = nearest_choice(
-            settings.nearest_policy, self._failures, settings.exhausted_after, settings.exhaustion_target
-        )
-        context = SampleContext(
-            points,
-            self._start_tree,
-            self._goal_tree,
-            rng.random,
-            sampler_counts,
-            nearest,
-            settings.goal_bias,
-            settings.min_quality,
-            settings.uniform_rate,
-        )
-        if settings.sample_policy == "valid_sampler":
-            si = self.getSpaceInformation()
-            context.valid_sampler = self._valid_state_sampler()
-            context.checker, context.scratch = si.getStateValidityChecker(), si.allocState()
-        return LoopPolicies(tree_choice, nearest, target_choice(settings.sample_policy, context))
 
     def _compiled_engine(self, solve: Solve) -> CompiledRun | None:
         """The compiled engine's run of ``solve``, or ``None`` when this solve runs on the Python engine."""
@@ -580,7 +453,7 @@ _PLAIN = {"balance_tree_sizes": "0"}
 class SwapLimitRRTConnect(BalancedRRTConnect):
     """Swap limiter: grow one tree until ``swap_steps`` connect steps were taken, then the other."""
 
-    POLICIES: ClassVar[dict[str, str]] = {**_PLAIN, "swap_policy": "balance_steps"}
+    POLICIES: ClassVar[dict[str, str]] = {**_PLAIN, "swap_policy": "swap_limit"}
 
 
 class CollisionSwapRRTConnect(BalancedRRTConnect):

@@ -7,7 +7,7 @@ is not selected costs the loop nothing:
 ``swap_policy`` and ``balance_tree_sizes`` -> :class:`TreeChoice`
     which tree an iteration grows: the balancing rule (grow the smaller tree once the
     trees drift apart in size), else alternation, the swap limiter or the collision swap;
-``nearest_policy`` -> :func:`nearest_choice`
+``nearest_policy`` -> :class:`NearestChoice`
     which node the tree grows from: the nearest, the nearest not yet exhausted, or the
     nearest by distance scaled with the node's failures;
 ``sample_policy`` -> :func:`target_choice`
@@ -34,12 +34,45 @@ from ompl import base as ob
 
 from .core.trees import Tree
 
-#: ``swap_policy`` choices: which tree an iteration grows when balancing does not decide.
-SWAP_POLICIES = ("alternate", "balance_steps", "on_collision")
-#: ``nearest_policy`` choices: which node a tree is extended from.
-NEAREST_POLICIES = ("euclidean", "exhausted", "exhaustion")
-#: ``sample_policy`` choices: where an iteration's target comes from.
-SAMPLE_POLICIES = ("uniform", "goal_bias", "goal_ball", "neighbour_quality", "valid_sampler")
+
+class SwapPolicy(enum.IntEnum):
+    """``swap_policy``: which tree an iteration grows when balancing does not decide (see :func:`choose_tree`)."""
+
+    ALTERNATE = 0  # the other tree, every iteration (stock RRT-Connect)
+    SWAP_LIMIT = 1  # the same tree until swap_steps connect steps were taken (the swap limiter)
+    ON_COLLISION = 2  # the same tree until a connect ends in a collision
+
+
+class NearestPolicy(enum.IntEnum):
+    """``nearest_policy``: which node a tree grows from (see :class:`NearestChoice`)."""
+
+    EUCLIDEAN = 0  # the nearest (the space's metric)
+    EXHAUSTED = 1  # the nearest with fewer than exhausted_after failed extensions
+    EXHAUSTION = 2  # the least distance x exhaustion_scale
+
+
+class SamplePolicy(enum.IntEnum):
+    """``sample_policy``: where an iteration's target comes from (see :func:`target_choice`)."""
+
+    UNIFORM = 0
+    GOAL_BIAS = 1
+    GOAL_BALL = 2
+    NEIGHBOUR_QUALITY = 3
+    VALID_SAMPLER = 4
+
+
+def _names(policy: type[enum.IntEnum]) -> tuple[str, ...]:
+    return tuple(member.name.lower() for member in policy)
+
+
+#: ``swap_policy`` choices, in :class:`SwapPolicy` order.
+SWAP_POLICIES = _names(SwapPolicy)
+#: ``nearest_policy`` choices, in :class:`NearestPolicy` order.
+NEAREST_POLICIES = _names(NearestPolicy)
+#: ``sample_policy`` choices, in :class:`SamplePolicy` order.
+SAMPLE_POLICIES = _names(SamplePolicy)
+#: Former names of policies, still accepted (with a message naming the new one).
+RENAMED_POLICIES = {"balance_steps": "swap_limit"}
 
 #: Draws a rejecting sample policy makes before the iteration is given up (OMPL's
 #: ``magic::MAX_VALID_SAMPLE_ATTEMPTS``).
@@ -51,7 +84,7 @@ class SwapCause(enum.IntEnum):
 
     ALTERNATE = 0  # alternation (stock RRT-Connect)
     BALANCE = 1  # the balancing rule chose the smaller tree
-    STEPS = 2  # the swap limit of ``balance_steps`` was reached
+    STEPS = 2  # the swap limit of ``swap_limit`` was reached
     COLLISION = 3  # a connect ended in a collision under ``on_collision``
 
 
@@ -94,18 +127,18 @@ def choose_tree(
     connect steps taken since the last swap and whether the last connect ended in a
     collision. The balancing rule first: with ``balance_tree_sizes`` and trees of different
     sizes, when :func:`tree_size_ratio` reaches ``max_tree_size_ratio`` the smaller tree
-    grows. Otherwise ``swap_policy`` (an index into :data:`SWAP_POLICIES`) decides:
+    grows. Otherwise ``swap_policy`` (a :class:`SwapPolicy`) decides:
 
-    ``alternate``      the other tree, every iteration (stock RRT-Connect);
-    ``balance_steps``  the same tree until ``swap_steps`` connect steps were taken since
-                       the last swap, then the other (the swap limiter);
-    ``on_collision``   the same tree until a connect ends in a collision, then the other.
+    ``alternate``     the other tree, every iteration (stock RRT-Connect);
+    ``swap_limit``    the same tree until ``swap_steps`` connect steps were taken since
+                      the last swap, then the other (the swap limiter);
+    ``on_collision``  the same tree until a connect ends in a collision, then the other.
     """
     if balance_tree_sizes and start_size != goal_size and tree_size_ratio(start_size, goal_size) >= max_tree_size_ratio:
         return start_size < goal_size, SwapCause.BALANCE
-    if swap_policy == 0:
+    if swap_policy == SwapPolicy.ALTERNATE:
         return not grew_start, SwapCause.ALTERNATE
-    if swap_policy == 1:
+    if swap_policy == SwapPolicy.SWAP_LIMIT:
         return (not grew_start if steps >= swap_steps else grew_start), SwapCause.STEPS
     return (not grew_start if collided else grew_start), SwapCause.COLLISION
 
@@ -113,7 +146,7 @@ def choose_tree(
 def balance_choice(start_size: int, goal_size: int, balance: bool, max_ratio: float) -> bool | None:
     """Which tree the balancing rule grows: ``True`` start, ``False`` goal, ``None`` no preference
     (the swap policy decides); see :func:`choose_tree`."""
-    grow_start, cause = choose_tree(0, balance, max_ratio, 1, False, start_size, goal_size, 0, False)
+    grow_start, cause = choose_tree(SwapPolicy.ALTERNATE, balance, max_ratio, 1, False, start_size, goal_size, 0, False)
     return grow_start if cause is SwapCause.BALANCE else None
 
 
@@ -191,19 +224,48 @@ def exhaustion_scale(failures: Any, target: int) -> Any:
 
 
 def nearest_not_exhausted(distances: np.ndarray, failures: np.ndarray, exhausted_after: int) -> int:
-    """Index of the nearest node with fewer than ``exhausted_after`` failed extensions.
+    """Index of the nearest node with fewer than ``exhausted_after`` failed extensions (the first
+    on ties).
 
     ``distances`` and ``failures`` are per node, ``(n,)``. When every node is exhausted,
-    the nearest of all (the tree must grow from somewhere).
+    the nearest of all (the tree must grow from somewhere). (A loop that allocates nothing:
+    the compiled engine compiles this function.)
     """
-    candidates = np.where(failures < exhausted_after, distances, np.inf)
-    index = int(candidates.argmin())
-    return index if candidates[index] < np.inf else int(distances.argmin())
+    found, closest = -1, 0
+    for i in range(len(distances)):
+        if distances[i] < distances[closest]:
+            closest = i
+        if failures[i] < exhausted_after and (found < 0 or distances[i] < distances[found]):
+            found = i
+    return found if found >= 0 else closest
 
 
 def nearest_by_exhaustion(distances: np.ndarray, failures: np.ndarray, target: int) -> int:
-    """Index of the node with the least ``distance * exhaustion_scale(failures, target)``."""
-    return int((distances * exhaustion_scale(failures, target)).argmin())
+    """Index of the node with the least ``distance * exhaustion_scale(failures, target)`` (the first
+    on ties; a loop the compiled engine compiles)."""
+    best, best_score = 0, np.inf
+    for i in range(len(distances)):
+        score = distances[i] * exhaustion_scale(failures[i], target)
+        if score < best_score:
+            best, best_score = i, score
+    return best
+
+
+def nearest_needs_ranking(nearest_policy: int, failures_of_nearest: int, exhausted_after: int) -> bool:
+    """Whether the nearest policy must rank every node (rather than take the nearest): always for
+    ``exhaustion``, for ``exhausted`` when the nearest node is exhausted, never for ``euclidean``."""
+    if nearest_policy == NearestPolicy.EUCLIDEAN:
+        return False
+    return nearest_policy == NearestPolicy.EXHAUSTION or failures_of_nearest >= exhausted_after
+
+
+def ranked_node(
+    nearest_policy: int, distances: np.ndarray, failures: np.ndarray, exhausted_after: int, target: int
+) -> int:
+    """The node a ranking nearest policy picks, given every node's distance and failures."""
+    if nearest_policy == NearestPolicy.EXHAUSTED:
+        return nearest_not_exhausted(distances, failures, exhausted_after)
+    return nearest_by_exhaustion(distances, failures, target)
 
 
 class NodeFailures:
@@ -229,70 +291,9 @@ class NodeFailures:
         return self.array[:size]
 
 
-class NearestChoice(Protocol):
-    """The node a tree grows from towards a target, and what a failed extension changes."""
-
-    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
-        """The node to extend and its distance to ``target``."""
-        ...
-
-    def failed(self, tree: Tree, node: int) -> None:
-        """An extension from ``node`` hit a collision."""
-        ...
-
-
-class NearestNode:
-    """``euclidean``: the nearest node (the space's metric)."""
-
-    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
-        return tree.nearest(target)
-
-    def failed(self, tree: Tree, node: int) -> None:
-        """Nothing to remember."""
-
-
-class _FailureCounting:
-    def __init__(self, failures: dict[Tree, NodeFailures]) -> None:
-        self.failures = failures
-
-    def failed(self, tree: Tree, node: int) -> None:
-        self.failures[tree].record(node)
-
-
-class NearestNotExhausted(_FailureCounting):
-    """``exhausted``: the nearest node with fewer than ``exhausted_after`` failures (:func:`nearest_not_exhausted`)."""
-
-    def __init__(self, failures: dict[Tree, NodeFailures], exhausted_after: int) -> None:
-        super().__init__(failures)
-        self.exhausted_after = exhausted_after
-
-    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
-        counts = self.failures[tree].counts(len(tree))
-        node, distance = tree.nearest(target)
-        if counts[node] < self.exhausted_after:
-            return node, distance  # the nearest of all is not exhausted: no need to rank
-        distances = tree.distances(target)
-        node = nearest_not_exhausted(distances, counts, self.exhausted_after)
-        return node, float(distances[node])
-
-
-class NearestByExhaustion(_FailureCounting):
-    """``exhaustion``: the least distance x :func:`exhaustion_scale` (``exhaustion_target``)."""
-
-    def __init__(self, failures: dict[Tree, NodeFailures], exhaustion_target: int) -> None:
-        super().__init__(failures)
-        self.exhaustion_target = exhaustion_target
-
-    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
-        distances = tree.distances(target)
-        node = nearest_by_exhaustion(distances, self.failures[tree].counts(len(tree)), self.exhaustion_target)
-        return node, float(distances[node])
-
-
-def nearest_choice(
-    nearest_policy: str, failures: dict[Tree, NodeFailures], exhausted_after: int = 15, exhaustion_target: int = 5
-) -> NearestChoice:
-    """The node choice of ``nearest_policy``; ``failures`` holds each tree's :class:`NodeFailures`.
+class NearestChoice:
+    """The node a tree grows from towards a target under ``nearest_policy`` (a :class:`NearestPolicy`
+    name), and what a failed extension changes; ``failures`` holds each tree's :class:`NodeFailures`.
 
     The planner asks the policy for each extension step and for the first step of each
     connect. A connect's further steps extend the node the step before added, as
@@ -303,12 +304,39 @@ def nearest_choice(
     the node the step before extended; extending that one again lands on the state just
     added, so a connect asking the policy could add that state over and over and never end.
     """
-    index = _choice("nearest_policy", nearest_policy, NEAREST_POLICIES)
-    if index == 1:
-        return NearestNotExhausted(failures, exhausted_after)
-    if index == 2:
-        return NearestByExhaustion(failures, exhaustion_target)
-    return NearestNode()
+
+    def __init__(
+        self,
+        nearest_policy: str,
+        failures: dict[Tree, NodeFailures],
+        exhausted_after: int = 15,
+        exhaustion_target: int = 5,
+    ) -> None:
+        self.policy = _choice("nearest_policy", nearest_policy, NEAREST_POLICIES)
+        self.failures = failures
+        self.exhausted_after = exhausted_after
+        self.exhaustion_target = exhaustion_target
+
+    def node(self, tree: Tree, target: Any) -> tuple[int, float]:
+        """The node to extend and its distance to ``target`` (the compiled engine's ``_find_nearest``
+        takes the same steps on its own tree arrays)."""
+        policy = self.policy
+        if policy != NearestPolicy.EXHAUSTION:
+            node, distance = tree.nearest(target)
+            if policy == NearestPolicy.EUCLIDEAN:
+                return node, distance
+            failures = self.failures[tree].counts(len(tree))
+            if not nearest_needs_ranking(policy, int(failures[node]), self.exhausted_after):
+                return node, distance
+        failures = self.failures[tree].counts(len(tree))
+        distances = tree.distances(target)
+        node = ranked_node(policy, distances, failures, self.exhausted_after, self.exhaustion_target)
+        return node, float(distances[node])
+
+    def failed(self, tree: Tree, node: int) -> None:
+        """An extension from ``node`` hit a collision (remembered by the policies that count failures)."""
+        if self.policy != NearestPolicy.EUCLIDEAN:
+            self.failures[tree].record(node)
 
 
 # -- sample_policy -------------------------------------------------------------------------
@@ -327,8 +355,18 @@ def node_quality(cost: float, optimal_cost: float, max_cost: float, min_quality:
     return max(min_quality, 1.0 - (cost - optimal_cost) / spread)
 
 
+def node_cost(start_distance: float, goal_distance: float) -> float:
+    """A node's cost for :func:`node_quality`: its distance from the start plus its distance to the goal."""
+    return start_distance + goal_distance
+
+
+def in_goal_ball(distance: float, radius: float) -> bool:
+    """Whether a sample ``distance`` from the goal ball's centre lies in it (``goal_ball``)."""
+    return distance <= radius
+
+
 class NodeCosts:
-    """``distance(start, node) + distance(node, goal)`` per node of one tree, and the largest.
+    """:func:`node_cost` per node of one tree, and the largest.
 
     Computed for the nodes added since the last :meth:`update`, so each node once.
     """
@@ -342,7 +380,7 @@ class NodeCosts:
         distance = self._distance
         for node in range(len(self.values), len(tree)):
             point = tree.state(node)
-            cost = distance(start, point) + distance(point, goal)
+            cost = node_cost(distance(start, point), distance(point, goal))
             self.values.append(cost)
             self.max = max(self.max, cost)
 
@@ -419,7 +457,7 @@ class GoalBallTargets:
         radius = distance(context.start_tree.state(0), context.goal_tree.state(0))
         for _ in range(SAMPLE_ATTEMPTS):
             point = context.points.sample()
-            if distance(point, centre) <= radius:
+            if in_goal_ball(distance(point, centre), radius):
                 return point, None
             context.counts.rejections += 1
         return None, None

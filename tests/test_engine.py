@@ -107,7 +107,7 @@ def test_every_preset_makes_the_python_engines_trees(preset, problem):
         {"balance_tree_sizes": "1", "max_tree_size_ratio": "0.5", "range": "0.05"},
         {"nearest_policy": "exhausted", "exhausted_after": "2", "sample_policy": "goal_bias", "goal_bias": "0.3"},
         {"nearest_policy": "exhaustion", "sample_policy": "neighbour_quality", "min_quality": "0.2"},
-        {"swap_policy": "balance_steps", "swap_steps": "3", "sample_policy": "goal_ball", "uniform_rate": "0.0"},
+        {"swap_policy": "swap_limit", "swap_steps": "3", "sample_policy": "goal_ball", "uniform_rate": "0.0"},
     ],
 )
 def test_policy_combinations_make_the_python_engines_trees(params):

@@ -21,6 +21,7 @@ from ompl_balance.policies import (
     SAMPLE_ATTEMPTS,
     SAMPLE_POLICIES,
     SWAP_POLICIES,
+    NearestChoice,
     NodeFailures,
     SampleContext,
     SamplerCounts,
@@ -31,7 +32,6 @@ from ompl_balance.policies import (
     choose_tree,
     exhaustion_scale,
     nearest_by_exhaustion,
-    nearest_choice,
     nearest_not_exhausted,
     node_quality,
     target_choice,
@@ -83,8 +83,8 @@ def test_balancing_is_the_balancing_rule_else_the_swap_policy():
             assert choose(grew_start, start_size, goal_size, 0, False) == expected
 
 
-def test_balance_steps_swaps_exactly_at_swap_steps():
-    choose = tree_rule("balance_steps", swap_steps=4)
+def test_swap_limit_swaps_exactly_at_swap_steps():
+    choose = tree_rule("swap_limit", swap_steps=4)
     for grew_start in (True, False):
         assert [choose(grew_start, 5, 500, steps, True)[0] for steps in range(7)] == [grew_start] * 4 + [
             not grew_start
@@ -100,7 +100,7 @@ def test_on_collision_swaps_only_after_a_collision():
 
 
 def test_tree_choice_resets_its_counts_at_a_swap_and_reports_only_swaps():
-    choice = TreeChoice("balance_steps", SwapState(), swap_steps=2)
+    choice = TreeChoice("swap_limit", SwapState(), swap_steps=2)
     assert choice.next_tree(1, 1) == (True, STEPS)  # the first iteration: as if due to swap
     assert (choice.state.steps, choice.state.collided) == (0, False)
     choice.connect_stepped()
@@ -112,7 +112,7 @@ def test_tree_choice_resets_its_counts_at_a_swap_and_reports_only_swaps():
 
 
 def test_unknown_swap_policy_names_the_accepted_ones():
-    with pytest.raises(ValueError, match="alternate, balance_steps, on_collision"):
+    with pytest.raises(ValueError, match="alternate, swap_limit, on_collision"):
         TreeChoice("sometimes", SwapState())
 
 
@@ -197,10 +197,8 @@ def replay_swaps(record):
 
 
 @pytest.mark.parametrize("engine", ENGINES)
-def test_balance_steps_swaps_after_exactly_swap_steps_connect_steps(engine):
-    _ss, planner, record = traced_run(
-        "bug_trap", engine, swap_policy="balance_steps", swap_steps=3, balance_tree_sizes=0
-    )
+def test_swap_limit_swaps_after_exactly_swap_steps_connect_steps(engine):
+    _ss, planner, record = traced_run("bug_trap", engine, swap_policy="swap_limit", swap_steps=3, balance_tree_sizes=0)
     decisions = replay_swaps(record)
     assert len(decisions) > 20
     for grew_start, grow_start, steps, _ in decisions:
@@ -463,7 +461,7 @@ OTHER_VALUES = {
     "intermediate_states": "1",
     "balance_tree_sizes": "0",
     "max_tree_size_ratio": "0.5",
-    "swap_policy": "balance_steps",
+    "swap_policy": "swap_limit",
     "swap_steps": "4",
     "nearest_policy": "exhaustion",
     "exhausted_after": "3",
@@ -542,7 +540,7 @@ def test_exhaustion_can_prefer_an_older_failed_node_to_the_node_just_added():
     failures = {tree: NodeFailures()}
     for _ in range(5):
         failures[tree].record(old)
-    policy = nearest_choice("exhaustion", failures, exhaustion_target=5)
+    policy = NearestChoice("exhaustion", failures, exhaustion_target=5)
     target = np.array([1.0, 0.0])
     assert policy.node(tree, target)[0] == old
     fresh = tree.add(np.array([0.05, 0.0]), old)  # the connect's step from ``old`` towards the target
@@ -664,3 +662,14 @@ def test_presets_solve_the_circle_in_every_run_and_their_strict_rules_do_not(pre
     ss.setPlanner(planner)
     iterations = iter(range(500))
     assert ss.solve(ob.PlannerTerminationCondition(lambda: next(iterations, None) is None)) == ob.PlannerStatus.TIMEOUT
+
+
+def test_the_former_name_of_the_swap_limiter_is_taken_with_a_message(capfd):
+    """``balance_steps`` (the swap limiter's former name: it is not balancing) is still accepted,
+    as ``swap_limit``, with an OMPL warning naming the new name."""
+    planner = BalancedRRTConnect(get_problem("open").setup().getSpaceInformation())
+    assert planner.params().setParam("swap_policy", "balance_steps")
+    assert planner.getSwapPolicy() == "swap_limit"
+    assert "'balance_steps' is now called 'swap_limit'" in capfd.readouterr().err
+    planner.setSwapPolicy("balance_steps")
+    assert planner.settings.swap_policy == "swap_limit"

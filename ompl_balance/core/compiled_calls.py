@@ -9,16 +9,21 @@ must pass arguments of exactly those types).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from typing import Any
 
 import numba
+from numba.core.errors import NumbaIRAssumptionWarning
 
 
 def entry_point(kernel: Any, arguments: tuple[Any, ...]) -> Callable[..., Any]:
     """The compiled function of numba ``kernel`` for the types of ``arguments``, compiled (or
-    loaded from numba's cache) now, without calling it."""
+    loaded from numba's cache) now, without calling it. (numba's internal pedantic check of
+    the views' inlined kernels, a warning meant for numba's developers, is not shown.)"""
     signature = tuple(numba.typeof(a) for a in arguments)
-    kernel.compile(signature)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
+        kernel.compile(signature)
     compiled: Any = kernel.overloads[signature]
     return compiled.entry_point

@@ -108,14 +108,14 @@ def row_distance(layout: SpaceLayout, states: np.ndarray, row: int, b: np.ndarra
 @njit_borrowing
 def distance(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> float:  # pragma: no cover (compiled)
     """OMPL's distance of flat states ``a`` and ``b``."""
-    return row_distance(layout, a.reshape((1, a.shape[0])), 0, b)
+    return row_distance(layout, a[None, :], 0, b)
 
 
 @njit_borrowing
 def segment_count(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> int:  # pragma: no cover (compiled)
     """OMPL's ``validSegmentCount(a, b)``: the largest over the leaves of ``factor * ceil(d / segment)``."""
     count = 0
-    rows = a.reshape((1, a.shape[0]))
+    rows = a[None, :]
     for leaf in range(len(layout.kind)):
         d = leaf_distance(layout, leaf, rows, 0, b)
         count = max(count, layout.factor[leaf] * math.ceil(d / layout.segment[leaf]))
@@ -179,7 +179,7 @@ def equal(layout: SpaceLayout, a: np.ndarray, b: np.ndarray) -> bool:  # pragma:
         elif kind == _SO2:
             if not abs(a[start] - b[start]) < 2.0 * _EPS:
                 return False
-        elif not leaf_distance(layout, leaf, a.reshape((1, a.shape[0])), 0, b) < _EPS:
+        elif not leaf_distance(layout, leaf, a[None, :], 0, b) < _EPS:
             return False
     return True
 
@@ -225,16 +225,3 @@ def nearest(
         if d < best_distance:
             best, best_distance = i, d
     return best, best_distance
-
-
-@njit(cache=True)
-def distances_to(
-    layout: SpaceLayout, states: np.ndarray, size: int, query: np.ndarray, out: np.ndarray
-) -> None:  # pragma: no cover
-    """The distance of each row of ``states[:size]`` to ``query`` into ``out[:size]``."""
-    if is_euclidean(layout):
-        for i in range(size):
-            out[i] = math.sqrt(_squared_distance(states, i, query))
-        return
-    for i in range(size):
-        out[i] = row_distance(layout, states, i, query)

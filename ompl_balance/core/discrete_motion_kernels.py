@@ -17,30 +17,28 @@ from .kernel_cache import njit, njit_borrowing
 def bisection_order(n: int, queue: np.ndarray, order: np.ndarray) -> None:  # pragma: no cover (compiled)
     """Write ``j = 1 .. n - 1`` into ``order[:n - 1]`` in the order OMPL tests the states at ``j / n``.
 
-    ``queue`` (rows, 2) holds the pending index ranges, a ring in which a range leaves before its
-    two halves enter, so ``n`` rows always suffice; ``queue`` and ``order`` must have at least
-    ``n`` rows (callers size them for the longest motion of their space, and make larger ones
-    for a longer motion).
+    ``queue`` (rows, 2) holds the index ranges in the order they are split, breadth first: each
+    of the ``n - 1`` indices is the middle of exactly one range, so ``n - 1`` rows hold them all
+    (no wrapping around); ``queue`` and ``order`` must have at least ``n`` rows (callers size
+    them for the longest motion of their space, and make larger ones for a longer motion).
     """
     if n < 2:
         return
-    head, tail, out = 0, 1, 0
     queue[0, 0], queue[0, 1] = 1, n - 1
-    while head != tail:
+    tail = 1
+    for head in range(n - 1):
         first, last = queue[head, 0], queue[head, 1]
-        head = (head + 1) % queue.shape[0]
         middle = (first + last) // 2
-        order[out] = middle
-        out += 1
+        order[head] = middle
         if first < middle:
             queue[tail, 0], queue[tail, 1] = first, middle - 1
-            tail = (tail + 1) % queue.shape[0]
+            tail += 1
         if last > middle:
             queue[tail, 0], queue[tail, 1] = middle + 1, last
-            tail = (tail + 1) % queue.shape[0]
+            tail += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """OMPL's ``DiscreteMotionValidator::checkMotion(a, b)`` with the state kernel of ``view.states``:
     ``b``, then the states between in its order (:mod:`ompl_balance.core.discrete_motions`) until

@@ -49,9 +49,10 @@ class Domain:
     """The values a parameter accepts.
 
     ``kind`` is ``bool``, ``int``, ``float`` or ``str``. Numbers lie in ``[low, high]``
-    (``low`` excluded when ``low_open``); strings are one of ``choices``; ``words`` are
-    strings accepted besides numbers (``"auto"``). ``suggestion`` is OMPL's range
-    suggestion, derived for booleans and choices.
+    (``low`` excluded when ``low_open``); strings are one of ``choices`` (or a former name in
+    ``renamed``, taken as its name now with an OMPL warning saying so); ``words`` are strings
+    accepted besides numbers (``"auto"``). ``suggestion`` is OMPL's range suggestion, derived
+    for booleans and choices.
     """
 
     kind: type
@@ -61,6 +62,7 @@ class Domain:
     choices: tuple[str, ...] | None = None
     words: tuple[str, ...] = ()
     suggestion: str = ""
+    renamed: tuple[tuple[str, str], ...] = ()  # (former choice, its name now): accepted, with a message
 
     def describe(self) -> str:
         """What is accepted, in words: ``"a number in [0, 1]"``, ``"one of a, b"``, ..."""
@@ -100,6 +102,10 @@ class Domain:
                 return lowered in _TRUE
             raise ValueError
         if self.kind is str:
+            now = dict(self.renamed).get(value)
+            if now is not None:
+                ou.OMPL_WARN(f"{value!r} is now called {now!r}; the former name will be removed in a later release")
+                value = now
             if self.choices is not None and value not in self.choices:
                 raise ValueError
             return str(value)
@@ -155,6 +161,7 @@ def param(
     suggestion: str = "",
     kind: type | None = None,
     accessor: str = "",
+    renamed: Mapping[str, str] | None = None,
 ) -> Any:
     """A field of a :class:`Settings` dataclass that is a parameter.
 
@@ -162,12 +169,12 @@ def param(
     as ``0.0``) unless ``kind`` is given (a number parameter whose default is one of its
     ``words``); ``doc`` is the meaning, with units; the keywords are the :class:`Domain`, and
     ``accessor`` the stem of the camelCase accessors when OMPL names them otherwise
-    (``"StdDev"`` for ``standard_deviation``).
+    (``"StdDev"`` for ``standard_deviation``); ``renamed`` maps former choices to their names now.
     """
     kind = type(default) if kind is None else kind
     if kind not in (bool, int, float, str):
         raise TypeError(f"a parameter's default must be a bool, int, float or str, got {default!r}")
-    domain = Domain(kind, low, high, low_open, choices, words, suggestion)
+    domain = Domain(kind, low, high, low_open, choices, words, suggestion, tuple((renamed or {}).items()))
     return field(default=default, metadata={"doc": doc, "domain": domain, "accessor": accessor})
 
 

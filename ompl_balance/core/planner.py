@@ -169,7 +169,7 @@ class TreePlanner(ob.Planner):
         ob.Planner.printSettings(self)
         self._cpp_overrides_resolved = True
         self.settings: Any = type(self).Settings()
-        self._params = ParamSet.of(self.settings)
+        self._params: ParamSet | None = None  # made at the first params(): a planner constructed is not configured
         self._rng = ou.RNG()  # per-planner stream, seeded from OMPL's global seed
         self._prepared: tuple[int, np.random.Generator] | None = None  # (seed, the next solve's generator)
         self._points: Points | None = None  # how solves see the space (made at setup)
@@ -182,6 +182,8 @@ class TreePlanner(ob.Planner):
 
     def params(self) -> ParamSet:
         """This planner's parameters (OMPL's ``ParamSet`` semantics)."""
+        if self._params is None:
+            self._params = ParamSet.of(self.settings)
         return self._params
 
     def getSpecs(self) -> PlannerSpecs:  # noqa: N802 (OMPL's names)
@@ -201,13 +203,13 @@ class TreePlanner(ob.Planner):
             f"Multithreaded:                 {yes(specs.multithreaded)}\n"
             f"Reports approximate solutions: {yes(specs.approximateSolutions)}\n"
             f"Can optimize solutions:        {yes(specs.optimizingPaths)}\n"
-            f"Aware of the following parameters: {' '.join(self._params.getParamNames())}\n"
+            f"Aware of the following parameters: {' '.join(self.params().getParamNames())}\n"
         )
 
     @_ForPythonCallers
     def printSettings(self) -> str:  # noqa: N802
         """The parameters and their values, as OMPL's ``Planner::printSettings``."""
-        values = "".join(f"{name} = {value}\n" for name, value in self._params.getParams().items())
+        values = "".join(f"{name} = {value}\n" for name, value in self.params().getParams().items())
         return f"Declared parameters for planner {self.getName()}:\n{values}"
 
     def setup(self) -> None:

@@ -25,11 +25,12 @@ from ..core.compiled_calls import entry_point
 from ..core.layout import SpaceLayout
 from ..core.spaces import SAMPLE_BLOCK, Points
 from ..core.trees import ArrayTree
-from ..policies import NEAREST_POLICIES, SAMPLE_POLICIES, SWAP_POLICIES, SwapCause
+from ..policies import SwapCause
 from . import loop
 from .events import Grow, GrowStep, TreeChoiceEvent
-from .index import KDIndex, grown, new_index
+from .index import INDEX_FROM, KDIndex, Setting, grown, new_index
 from .loop import Real, Record, Slot, Stop
+from .settings import RRTConnectSettings, loop_settings
 from .solve import Solve
 from .uniforms import bit_generator_address
 from .views import EngineChecks
@@ -37,28 +38,6 @@ from .views import EngineChecks
 #: A slice of iterations lasts this long (ns, and the iteration under way at its end): the
 #: termination condition's polling period (a slice costs some 20 microseconds of Python around it).
 SLICE_NS = 2_000_000
-
-
-def settings_of(points: Points, settings: Any, record: bool) -> loop.Settings:
-    """The compiled loop's settings for solves of a planner with ``settings`` (its
-    RRTConnectSettings) on ``points``, recording what the loop does or not."""
-    return loop.Settings(
-        range=float(settings.range),
-        intermediate_states=bool(settings.intermediate_states),
-        step_may_stall=bool(points.may_stall(settings.range)),
-        balance_tree_sizes=bool(settings.balance_tree_sizes),
-        max_tree_size_ratio=float(settings.max_tree_size_ratio),
-        swap_policy=SWAP_POLICIES.index(settings.swap_policy),
-        swap_steps=int(settings.swap_steps),
-        nearest_policy=NEAREST_POLICIES.index(settings.nearest_policy),
-        exhausted_after=int(settings.exhausted_after),
-        exhaustion_target=int(settings.exhaustion_target),
-        sample_policy=SAMPLE_POLICIES.index(settings.sample_policy),
-        goal_bias=float(settings.goal_bias),
-        uniform_rate=float(settings.uniform_rate),
-        min_quality=float(settings.min_quality),
-        record=record,
-    )
 
 
 class SolveArrays:
@@ -88,18 +67,19 @@ class SolveArrays:
         self._planner_trees: tuple[ArrayTree, ...] = ()  # the trees the indexes and costs are for
         self.indexes: list[KDIndex] = []
         self.costs: list[np.ndarray] = []
+        self.distances: list[np.ndarray] = []  # the ranking nearest policies' scratch, per tree
         self.failures: list[Any] = []
         self.room = 0
-        self._fits = -1  # tree sizes up to which every array of :attr:`trees` has room for an iteration
-        self._settings: tuple[tuple[Any, ...], loop.Settings] | None = None  # the last solve's, and their source
+        self._fitted = False  # whether the loop's sizes with room (Slot.START_FITS, GOAL_FITS) are the arrays' own
+        self._settings: tuple[tuple[Any, ...], Any] | None = None  # the last solve's LoopSettings, and their source
 
-    def settings_for(self, points: Points, settings: Any, record: bool) -> loop.Settings:
-        """The compiled loop's settings for solves of a planner with ``settings`` (its
-        RRTConnectSettings) on ``points``, recording or not: the last ones made when all three
-        are unchanged (planners ask at setup, so that a solve finds them made)."""
+    def settings_for(self, points: Points, settings: RRTConnectSettings, record: bool) -> Any:
+        """The compiled loop's :data:`~ompl_balance.engine.settings.LoopSettings` for solves of a planner
+        with ``settings`` on ``points``, recording or not: the last ones made when all three are
+        unchanged (planners ask at setup, so that a solve finds them made)."""
         source = (points, record, *vars(settings).values())
         if self._settings is None or self._settings[0] != source:
-            self._settings = (source, settings_of(points, settings, record))
+            self._settings = (source, loop_settings(settings, points.may_stall(settings.range), record))
         return self._settings[1]
 
     def hold(self, start_tree: ArrayTree, goal_tree: ArrayTree) -> None:
@@ -110,8 +90,9 @@ class SolveArrays:
             return
         self._planner_trees = (start_tree, goal_tree)
         capacities = [len(tree.storage().parents) for tree in self._planner_trees]
-        self.indexes = [new_index(self.layout, capacity) for capacity in capacities]
+        self.indexes = [new_index(self.layout, 0) for _ in capacities]  # (grown once a tree needs it)
         self.costs = [np.empty(capacity) for capacity in capacities]
+        self.distances = [np.empty(capacity) for capacity in capacities]
 
     def start(self, solve: Solve, room: int, record: bool) -> None:
         """Ready the arrays for ``solve`` (``room``: the nodes an iteration may add; ``record``:
@@ -128,7 +109,7 @@ class SolveArrays:
             self.loop = self.loop._replace(
                 record=np.empty((rows, Record.COUNT), dtype=np.int64), record_target=np.empty((rows, self.layout.dim))
             )
-        self._fits = -1  # (the arrays may have moved since the last solve)
+        self._fitted = False  # (the arrays may have moved since the last solve)
         self.make_room()
 
     def make_room(self) -> None:
@@ -141,8 +122,16 @@ class SolveArrays:
         sizes = [len(tree) for tree in self._planner_trees]
         self.loop.sizes[:] = sizes
         self._make_record_room()
-        if max(sizes) <= self._fits:
+        fits = self.loop.ints[Slot.START_FITS : Slot.GOAL_FITS + 1]
+        if self._fitted and all(size <= fit for size, fit in zip(sizes, fits)):
             return
+        self._make_tree_room()
+        fits[:] = [_nodes_with_room(tree) - self.room for tree in self.trees]
+        self._fitted = True
+
+    def _make_tree_room(self) -> None:
+        """Room in the trees' arrays for one more iteration (the loop asks for more once a tree
+        grows past the sizes :func:`_nodes_with_room` gives, the one statement of the bound)."""
         trees = []
         for t, tree in enumerate(self._planner_trees):
             needed = len(tree) + self.room
@@ -153,14 +142,21 @@ class SolveArrays:
             failures.reserve(capacity)
             if len(self.costs[t]) < capacity:
                 self.costs[t] = _grown(self.costs[t], capacity)
-            self.indexes[t] = index = grown(self.indexes[t], capacity)
+                self.distances[t] = np.empty(capacity)
+            # the index's arrays once the tree is large enough to be searched through them
+            self.indexes[t] = index = grown(self.indexes[t], capacity if needed >= INDEX_FROM else 0)
             trees.append(
-                loop.Tree(storage.states, storage.parents, storage.roots, failures.array, self.costs[t], index)
+                loop.Tree(
+                    storage.states,
+                    storage.parents,
+                    storage.roots,
+                    failures.array,
+                    self.costs[t],
+                    self.distances[t],
+                    index,
+                )
             )
         self.trees = trees[0], trees[1]
-        self._fits = (
-            min(min(len(t.states), len(t.parents), len(t.failures), len(t.costs)) for t in self.trees) - self.room
-        )
 
     def _make_record_room(self) -> None:
         """Room in the record (when the loop records) for one more iteration's rows."""
@@ -188,6 +184,15 @@ def _runner(key: Any, *arguments: Any) -> Callable[..., int]:
     if key not in _RUNNERS:
         _RUNNERS[key] = entry_point(loop.run, arguments)
     return _RUNNERS[key]
+
+
+def _nodes_with_room(tree: loop.Tree) -> int:
+    """Nodes ``tree``'s arrays have room for (its index's: below :data:`INDEX_FROM` nodes, none needed)."""
+    rows = min(len(tree.states), len(tree.parents), len(tree.failures), len(tree.costs), len(tree.distances))
+    index = tree.neighbours
+    if index.ints[Setting.AXES] and len(index.order) < rows:
+        rows = max(len(index.order), INDEX_FROM - 1)
+    return rows
 
 
 def _grown(array: np.ndarray, rows: int) -> np.ndarray:
@@ -334,12 +339,13 @@ def _fill_record(solve: Solve, arrays: loop.Loop) -> None:
 def warm_up(view: object, layout: SpaceLayout) -> None:
     """Compile :func:`ompl_balance.engine.loop.run` for ``view``'s kind of checks (or load it from
     numba's cache): a call of no iterations with arrays of the types a solve passes."""
-    settings = loop.Settings(1.0, False, False, True, 1.0, 0, 1, 0, 1, 1, 0, 0.0, 0.0, 0.0, False)
+    settings = loop_settings(RRTConnectSettings(range=1.0), step_may_stall=False, record=False)
     tree = loop.Tree(
         np.zeros((1, layout.dim)),
         np.zeros(1, dtype=np.int64),
         np.zeros(1, dtype=np.int64),
         np.zeros(1, dtype=np.int64),
+        np.zeros(1),
         np.zeros(1),
         new_index(layout, 1),
     )

@@ -62,6 +62,4 @@ class LoopCounts:
 
     iterations: int = 0
     swaps: list[int] = field(default_factory=lambda: [0] * len(SwapCause))  # by SwapCause
-    sampler_rejections: int = 0
-    sampler_checks: int = 0
     exits: int = 0  # calls out of compiled code to Python (compiled engine)

@@ -13,8 +13,11 @@ It runs iterations for a slice of time (its own monotonic clock, read once an it
 side (:mod:`ompl_balance.engine.driver`) polls the termination condition between calls,
 feeds goal states, makes room in the trees and ends the solve when the trees
 connect. Everything it changes lives in arrays the caller owns (:class:`Loop`), so a call
-resumes where the last one stopped. The rules themselves (balancing, swaps, exhaustion,
-node quality) are the functions of :mod:`ompl_balance.policies`, compiled here.
+resumes where the last one stopped. The policies' rules are the functions of
+:mod:`ompl_balance.policies`, compiled here, which the Python engine calls as they are: the
+tree choice (balancing and swaps), whether a nearest policy ranks every node and which node
+it picks, a node's cost and quality, the goal ball; the settings are
+:data:`~ompl_balance.engine.settings.LoopSettings`, made from the planner's parameter table.
 """
 
 from __future__ import annotations
@@ -30,14 +33,22 @@ from ..core.checks import Count, motion_free, state_free
 from ..core.compiled_spaces import distance, equal, interpolate, row_distance, samples_from_uniforms, segment_count
 from ..core.kernel_cache import njit, njit_borrowing
 from ..core.layout import SpaceLayout
+from ..policies import NearestPolicy, SamplePolicy
 from .clock import monotonic_ns
 from .events import Grow
 from .index import KDIndex, indexed_nearest
+from .settings import LoopSettings
 from .uniforms import next_double
 
 register_jitable(policies.tree_size_ratio)  # callable from the compiled choose_tree
+register_jitable(policies.exhaustion_scale)  # ... and nearest_by_exhaustion
+register_jitable(policies.nearest_not_exhausted)  # ... and ranked_node
+register_jitable(policies.nearest_by_exhaustion)
 choose_tree = njit(cache=True)(policies.choose_tree)
-exhaustion_scale = njit(cache=True)(policies.exhaustion_scale)
+nearest_needs_ranking = njit_borrowing(policies.nearest_needs_ranking)
+ranked_node = njit_borrowing(policies.ranked_node)
+node_cost = njit(cache=True, inline="always")(policies.node_cost)
+in_goal_ball = njit(cache=True, inline="always")(policies.in_goal_ball)
 node_quality = njit(cache=True)(policies.node_quality)
 
 NO_NODE = -1
@@ -69,11 +80,13 @@ class Slot(enum.IntEnum):
     MORE_GOALS = 12  # PlannerInputStates::haveMoreGoalStates()
     START_NODE = 13  # the connection, when CONNECTED
     GOAL_NODE = 14
-    ROOM = 15  # nodes one iteration may add to a tree
+    ROOM = 15  # nodes one iteration may add to a tree (for the record's room)
     START_COSTS = 16  # nodes whose neighbour-quality cost is known, per tree
     GOAL_COSTS = 17
     RECORDED = 18  # rows of the record in use
-    COUNT = 19
+    START_FITS = 19  # per tree, the size up to which every array of the tree has room for one more iteration
+    GOAL_FITS = 20
+    COUNT = 21
 
 
 class Real(enum.IntEnum):
@@ -98,35 +111,17 @@ class Record(enum.IntEnum):
     COUNT = 7
 
 
-class Settings(NamedTuple):
-    """The parameters of one solve (:class:`~ompl_balance.planners.RRTConnectSettings`, policies as indices)."""
-
-    range: float
-    intermediate_states: bool
-    step_may_stall: bool
-    balance_tree_sizes: bool
-    max_tree_size_ratio: float
-    swap_policy: int  # index in policies.SWAP_POLICIES
-    swap_steps: int
-    nearest_policy: int  # index in policies.NEAREST_POLICIES
-    exhausted_after: int
-    exhaustion_target: int
-    sample_policy: int  # index in policies.SAMPLE_POLICIES
-    goal_bias: float
-    uniform_rate: float
-    min_quality: float
-    record: bool  # fill Loop.record
-
-
 class Tree(NamedTuple):
     """One tree's arrays (capacity rows): states (capacity, dim), parents, roots, failed
-    extensions per node, neighbour-quality costs, and its nearest-neighbour :class:`~ompl_balance.engine.index.KDIndex`."""
+    extensions per node, neighbour-quality costs, every node's distance to a query (the ranking
+    nearest policies' scratch), and its nearest-neighbour :class:`~ompl_balance.engine.index.KDIndex`."""
 
     states: np.ndarray
     parents: np.ndarray
     roots: np.ndarray
     failures: np.ndarray
     costs: np.ndarray
+    distances: np.ndarray
     neighbours: KDIndex  # the nearest-neighbour index
 
 
@@ -150,10 +145,8 @@ class Loop(NamedTuple):
     record_target: np.ndarray
 
 
-_EUCLIDEAN, _EXHAUSTED, _EXHAUSTION = (policies.NEAREST_POLICIES.index(name) for name in policies.NEAREST_POLICIES)
-_UNIFORM, _GOAL_BIAS, _GOAL_BALL, _QUALITY = (
-    policies.SAMPLE_POLICIES.index(name) for name in ("uniform", "goal_bias", "goal_ball", "neighbour_quality")
-)
+_EUCLIDEAN, _EXHAUSTION = int(NearestPolicy.EUCLIDEAN), int(NearestPolicy.EXHAUSTION)
+_UNIFORM, _GOAL_BIAS, _GOAL_BALL = int(SamplePolicy.UNIFORM), int(SamplePolicy.GOAL_BIAS), int(SamplePolicy.GOAL_BALL)
 _SAMPLE_ATTEMPTS = policies.SAMPLE_ATTEMPTS
 _TRAPPED, _ADVANCED, _REACHED = int(Grow.TRAPPED), int(Grow.ADVANCED), int(Grow.REACHED)
 _CHOICE, _EXTENSION, _CONNECT_STEP = 0, 1, 2  # kinds of row in the loop record
@@ -177,27 +170,20 @@ def _uniform(layout: SpaceLayout, loop: Loop, bits: int) -> int:  # pragma: no c
 
 @njit_borrowing
 def _find_nearest(
-    settings: Settings, layout: SpaceLayout, tree: Tree, size: int, target: np.ndarray
+    settings: LoopSettings, layout: SpaceLayout, tree: Tree, size: int, target: np.ndarray
 ) -> tuple[int, float]:  # pragma: no cover (compiled)
-    """The node the nearest policy extends towards ``target``, and its distance (first on ties)."""
-    if settings.nearest_policy != _EXHAUSTION:
+    """The node the nearest policy extends towards ``target``, and its distance (first on ties):
+    the nearest, unless the policy ranks every node (as ``NearestChoice.node`` does)."""
+    policy = settings.nearest_policy
+    if policy != _EXHAUSTION:
         node, best = indexed_nearest(tree.neighbours, layout, tree.states, size, target)
-        if settings.nearest_policy == _EUCLIDEAN or tree.failures[node] < settings.exhausted_after:
-            return node, best  # the nearest of all is not exhausted: no need to rank
-    found, found_distance, score = NO_NODE, np.inf, np.inf
-    closest, closest_distance = 0, np.inf
+        if not nearest_needs_ranking(policy, tree.failures[node], settings.exhausted_after):
+            return node, best
+    distances = tree.distances[:size]
     for i in range(size):
-        d = row_distance(layout, tree.states, i, target)
-        if d < closest_distance:
-            closest, closest_distance = i, d
-        if settings.nearest_policy == _EXHAUSTED:
-            if tree.failures[i] < settings.exhausted_after and d < found_distance:
-                found, found_distance = i, d
-        else:
-            scaled = d * exhaustion_scale(tree.failures[i], settings.exhaustion_target)
-            if scaled < score:
-                found, found_distance, score = i, d, scaled
-    return (found, found_distance) if found != NO_NODE else (closest, closest_distance)
+        distances[i] = row_distance(layout, tree.states, i, target)
+    node = ranked_node(policy, distances, tree.failures[:size], settings.exhausted_after, settings.exhaustion_target)
+    return node, distances[node]
 
 
 @njit_borrowing
@@ -228,7 +214,7 @@ def _note(loop: Loop, iteration: int, kind: int, a: int, b: int, c: int, d: int,
 
 @njit_borrowing
 def _node_towards(
-    settings: Settings,
+    settings: LoopSettings,
     layout: SpaceLayout,
     trees: tuple[Tree, Tree],
     loop: Loop,
@@ -247,7 +233,7 @@ def _node_towards(
 def _extend(
     checks: Any,
     layout: SpaceLayout,
-    settings: Settings,
+    settings: LoopSettings,
     trees: tuple[Tree, Tree],
     loop: Loop,
     t: int,
@@ -277,7 +263,7 @@ def _extend(
     else:
         valid = state_free(checks, new) and motion_free(checks, new, near)
     if not valid:
-        if settings.nearest_policy != _EUCLIDEAN:
+        if settings.nearest_policy != _EUCLIDEAN:  # (the policies that rank count failures)
             tree.failures[node] += 1
         return _TRAPPED, NO_NODE
     added = node
@@ -305,13 +291,13 @@ def _note_step(
 
 @njit_borrowing
 def _update_costs(layout: SpaceLayout, trees: tuple[Tree, Tree], loop: Loop, t: int) -> None:  # pragma: no cover
-    """Neighbour-quality costs ``d(start, node) + d(node, goal)`` of tree ``t``'s new nodes."""
+    """Neighbour-quality costs (:func:`~ompl_balance.policies.node_cost`) of tree ``t``'s new nodes."""
     start, goal = trees[START].states[0], trees[GOAL].states[0]
     tree = trees[t]
     largest = loop.reals[Real.START_COST_MAX + t]
     for node in range(loop.ints[Slot.START_COSTS + t], loop.sizes[t]):
         point = tree.states[node]
-        cost = distance(layout, start, point) + distance(layout, point, goal)
+        cost = node_cost(distance(layout, start, point), distance(layout, point, goal))
         tree.costs[node] = cost
         largest = max(largest, cost)
     loop.reals[Real.START_COST_MAX + t] = largest
@@ -324,7 +310,7 @@ OTHER_ROOT = -1
 
 @njit_borrowing
 def _target(
-    layout: SpaceLayout, settings: Settings, trees: tuple[Tree, Tree], loop: Loop, bits: int, t: int
+    layout: SpaceLayout, settings: LoopSettings, trees: tuple[Tree, Tree], loop: Loop, bits: int, t: int
 ) -> tuple[int, int, bool]:  # pragma: no cover (compiled)
     """The iteration's target: its row of ``loop.block`` (:data:`OTHER_ROOT`: the other tree's
     root), the node to extend when the policy found it (``NO_NODE``: look it up), and ``False``
@@ -347,7 +333,7 @@ def _target(
         radius = distance(layout, start, goal)
         for _ in range(_SAMPLE_ATTEMPTS):
             row = _uniform(layout, loop, bits)
-            if distance(layout, loop.block[row], centre) <= radius:
+            if in_goal_ball(distance(layout, loop.block[row], centre), radius):
                 return row, NO_NODE, True
             loop.ints[Slot.REJECTIONS] += 1
         return 0, NO_NODE, False
@@ -368,7 +354,7 @@ def _target(
 def run(
     checks: Any,
     layout: SpaceLayout,
-    settings: Settings,
+    settings: LoopSettings,
     trees: tuple[Tree, Tree],
     loop: Loop,
     bits: int,
@@ -383,9 +369,8 @@ def run(
     deadline = monotonic_ns() + slice_ns
     while monotonic_ns() < deadline:
         if ints[Slot.GOAL_FED] == 0:
-            for t in range(2):
-                if trees[t].parents.shape[0] - sizes[t] < room:
-                    return Stop.NEED_ROOM
+            if sizes[START] > ints[Slot.START_FITS] or sizes[GOAL] > ints[Slot.GOAL_FITS]:
+                return Stop.NEED_ROOM
             if settings.record and loop.record.shape[0] - ints[Slot.RECORDED] < room + 2:
                 return Stop.NEED_ROOM
             # goal states join the goal tree while fewer than half of its states were sampled
@@ -442,7 +427,7 @@ def run(
         if grown == _TRAPPED:
             continue
         # connect: walk the other tree towards the state just added until trapped or there;
-        # each further step extends the node just added (see policies.nearest_choice)
+        # each further step extends the node just added (see policies.NearestChoice)
         reach = trees[t].states[added]  # stays put: only the other tree grows while connecting
         connected, reached, given = _ADVANCED, NO_NODE, NO_NODE
         while connected == _ADVANCED:

@@ -13,16 +13,55 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from ompl import base as ob
 
 from ..core.spaces import Points
 from ..core.trees import NO_PARENT, Tree
-from ..policies import NearestChoice
+from ..policies import NearestChoice, SampleContext, TargetChoice, TreeChoice, target_choice
 from .events import Grow, GrowStep, LoopRecord, TreeChoiceEvent
 from .solve import Solve
+
+
+class LoopPolicies(NamedTuple):
+    """A solve's policies as the Python engine calls them (the compiled engine runs the same rules
+    from its settings: :mod:`ompl_balance.engine.loop`)."""
+
+    tree_choice: TreeChoice  # which tree grows next
+    nearest: NearestChoice  # which node extends towards a target
+    targets: TargetChoice  # where an iteration's target comes from
+
+
+def loop_policies(solve: Solve) -> LoopPolicies:
+    """The policies of ``solve``'s settings, as objects over its trees and random numbers."""
+    settings = solve.settings
+    tree_choice = TreeChoice(
+        settings.swap_policy,
+        solve.swap_state,
+        settings.balance_tree_sizes,
+        settings.max_tree_size_ratio,
+        settings.swap_steps,
+    )
+    nearest = NearestChoice(
+        settings.nearest_policy, solve.failures, settings.exhausted_after, settings.exhaustion_target
+    )
+    context = SampleContext(
+        solve.points,
+        solve.start_tree,
+        solve.goal_tree,
+        solve.rng.random,
+        solve.sampler_counts,
+        nearest,
+        settings.goal_bias,
+        settings.min_quality,
+        settings.uniform_rate,
+    )
+    if solve.valid_sampler is not None:
+        context.valid_sampler = solve.valid_sampler
+        context.checker, context.scratch = solve.si.getStateValidityChecker(), solve.si.allocState()
+    return LoopPolicies(tree_choice, nearest, target_choice(settings.sample_policy, context))
 
 
 @dataclass
@@ -93,7 +132,7 @@ def run(solve: Solve, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus.P
     says stop (``TIMEOUT``) or no goal state can be had (``INVALID_GOAL``)."""
     settings, points, counts = solve.settings, solve.points, solve.counts
     start_tree, goal_tree = solve.start_tree, solve.goal_tree
-    choice, nearest, targets = solve.policies()
+    choice, nearest, targets = loop_policies(solve)
     record = solve.record
     extender = Extender(
         points,
@@ -132,7 +171,7 @@ def run(solve: Solve, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus.P
         choice.connect_stepped()
         while connected is Grow.ADVANCED:
             # Each further step extends the node just added (why not the nearest policy's
-            # choice: see policies.nearest_choice).
+            # choice: see policies.NearestChoice).
             connected, reached, gap = extender.grow(other_tree, not grow_start, target, iteration, True, reached)
             choice.connect_stepped()
         # OMPL's "approx goal distance": the other tree's nearest node to the state just

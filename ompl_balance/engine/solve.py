@@ -1,17 +1,15 @@
 """One solve of an RRT-Connect planner, as both engines see it.
 
 :class:`Solve` holds what the planner hands an engine for one ``solve()``: the trees and
-what its policies keep across solves, this solve's settings (and, for the Python engine, its
-policies as objects), the planner input states and the goal, and what the engine reports
-back (counts, the gap between the trees, the record). Goal feeding and the acceptance of a
-connection are the same for both engines, so they live here.
+what its policies keep across solves, this solve's settings, the planner input states and
+the goal, and what the engine reports back (counts, the gap between the trees, the record).
+Goal feeding and the acceptance of a connection are the same for both engines, so they live
+here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
 
 import numpy as np
 from ompl import base as ob
@@ -20,17 +18,9 @@ from ompl import util as ou
 from ..core.planner import Progress
 from ..core.spaces import Points
 from ..core.trees import Tree
-from ..policies import NearestChoice, NodeFailures, SamplerCounts, SwapState, TargetChoice, TreeChoice
+from ..policies import NodeFailures, SamplerCounts, SwapState
 from .events import LoopCounts, LoopRecord
-
-
-class LoopPolicies(NamedTuple):
-    """A solve's policies as the Python engine calls them (the compiled engine reads the
-    same rules from the settings)."""
-
-    tree_choice: TreeChoice  # which tree grows next
-    nearest: NearestChoice  # which node extends towards a target
-    targets: TargetChoice  # where an iteration's target comes from
+from .settings import RRTConnectSettings
 
 
 @dataclass
@@ -40,17 +30,17 @@ class Solve:
     name: str  # the planner's name, for OMPL's messages
     si: ob.SpaceInformation
     points: Points
-    settings: Any  # the planner's RRTConnectSettings
+    settings: RRTConnectSettings
     start_tree: Tree
     goal_tree: Tree
     failures: dict[Tree, NodeFailures]  # per tree, kept across solves
     swap_state: SwapState  # what the tree choice remembers, kept across solves
-    policies: Callable[[], LoopPolicies]  # this solve's policies, made when the Python engine runs
     inputs: ob.PlannerInputStates
     goal: ob.GoalSampleableRegion
     progress: Progress
     rng: np.random.Generator  # the solve's random numbers (the targets' samples and draws)
     record: LoopRecord | None = None
+    valid_sampler: ob.ValidStateSampler | None = None  # sample_policy = valid_sampler's (the planner's)
     counts: LoopCounts = field(default_factory=LoopCounts)
     sampler_counts: SamplerCounts = field(default_factory=SamplerCounts)  # what the sample policy did
     tree_gap: float = float("inf")  # least distance between the trees seen after a connect
