@@ -80,6 +80,7 @@ _LAZY = {
     "RobotModel": "collision.kinematics",
     "Environment": "collision.environment",
     "CollisionChecker": "collision.checker",
+    "Contact": "collision.contacts",
     "load_example_robot_data_panda": "collision.robots",
     "load_panda_vamp": "collision.robots",
     "StateValidityChecker": "validity",
