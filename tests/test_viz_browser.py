@@ -125,6 +125,7 @@ def test_the_live_viewer_moves_the_robot_to_the_frame_asked_for():
         viewer.stop()
 
 
+@pytest.mark.slow
 def test_an_invalid_start_is_painted_red_where_it_collides(tmp_path):
     """A Panda start in collision: no path; the links in contact, and what they touch, red."""
     executable = chromium_or_skip()
