@@ -43,7 +43,10 @@ def main() -> None:
 
     start = np.array([-0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # hand in front, left of the box
     goal = np.array([0.9, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02])  # mirrored, right of the box
-    assert checker.check([start, goal]).all(), "start and goal must be collision-free"
+    for side, q in (("start", start), ("goal", goal)):
+        if not checker.is_valid(q):  # name what collides (or the joint limits, when nothing does)
+            contacts = ", ".join(map(str, checker.collisions(q))) or "outside the joint limits"
+            sys.exit(f"panda_table.py: the {side} configuration is not valid: {contacts}")
 
     for name, make_planner in [("RRTConnect", og.RRTConnect), ("BalancedRRTConnect", BalancedRRTConnect)]:
         ss = og.SimpleSetup(space_for(robot))

@@ -11,10 +11,10 @@ the robot layer (:mod:`ompl_balance.collision` and its OMPL adapters,
 :mod:`~ompl_balance.validity`), problems (:mod:`ompl_balance.worlds`) and the benchmark
 runner (:mod:`ompl_balance.bench`).
 
-The robot layer (trimesh, FCL, numba) and the benchmark runner are imported on first
-use, so ``import ompl_balance`` stays quick when they are not needed: their names
-(``CollisionChecker``, ``setup_robot``, ``load_mbm``, ``RigidBodyChecker``, ``load_omplapp``,
-``rigid_problem``, ``bench``, ...) are attributes of
+The robot layer (trimesh, FCL, numba), the benchmark runner and the viewer (``show``, the
+``viz`` extra) are imported on first use, so ``import ompl_balance`` stays quick when they are
+not needed: their names (``CollisionChecker``, ``setup_robot``, ``load_mbm``,
+``RigidBodyChecker``, ``load_omplapp``, ``rigid_problem``, ``bench``, ``show``, ...) are attributes of
 this package but not in ``__all__``, so ``from ompl_balance import *`` does not load them.
 """
 
@@ -80,6 +80,7 @@ _LAZY = {
     "RobotModel": "collision.kinematics",
     "Environment": "collision.environment",
     "CollisionChecker": "collision.checker",
+    "Contact": "collision.contacts",
     "load_example_robot_data_panda": "collision.robots",
     "load_panda_vamp": "collision.robots",
     "StateValidityChecker": "validity",
@@ -129,6 +130,7 @@ _LAZY = {
     "path_length_objective": "rrtstar",
     "setup_checker": "checking",
     "CheckerError": "checking",
+    "show": "viz",
 }
 
 __all__ = [

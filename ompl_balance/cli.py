@@ -17,6 +17,9 @@
 ``ompl-balance gamma``
     RRT*'s ball-radius constant for a built-in problem or an occupancy grid, and the
     ``rewire_factor`` that gives OMPL's ``RRTstar`` the same radius schedule.
+``ompl-balance show PROBLEM [-o FILE.html]``
+    plans a problem and shows it in the browser: live, or written to one self-contained HTML
+    file (the ``viz`` extra; :mod:`ompl_balance.viz`).
 
 Every run executes in its own process, after an untimed short solve that warms the
 planner's code up (``--no-warm-up`` to time the cold first solve); ``--jobs N`` runs N at a
@@ -248,7 +251,81 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="maximum connection distance for the radius table, in the space's units (default 0.2 x extent)",
     )
+    _add_show(commands)
     return parser
+
+
+def _add_show(commands: argparse._SubParsersAction) -> None:
+    """The ``show`` subcommand's arguments."""
+    show = commands.add_parser(
+        "show",
+        help="plan a problem and show it in the browser: live, or one offline HTML file (the viz extra)",
+        description="Plan a problem and show it: the robot or body, the obstacles, start and goal, the path "
+        "animated (slider and play button) and, with --trees, both trees. Without -o a live viewer in the browser "
+        "(this machine only unless --host says otherwise; Ctrl-C ends it); with -o one self-contained HTML file "
+        "that opens offline. Exits 1 when no path was found (the problem is shown all the same, what makes its "
+        "start or goal invalid named and painted red).",
+    )
+    show.add_argument(
+        "problem",
+        help="a 2-D world (open, narrow_gap, bug_trap, maze, twin_pockets, rooms, rooms_se2, env1, env2, circles), "
+        f"a MotionBenchMaker Panda problem SCENARIO.ID (e.g. table_pick.001), a rigid body ({', '.join(RIGID_PROBLEMS)}) "
+        "or an OMPL.app .cfg file",
+    )
+    show.add_argument(
+        "-o", "--out", type=_html_file, default=None, metavar="FILE.html", help="write one HTML file instead"
+    )
+    show.add_argument(
+        "--planner",
+        default="BalancedRRTConnect",
+        metavar="NAME[param=value;...]",
+        help="a stock OMPL planner or one of the package's, with parameters (default BalancedRRTConnect)",
+    )
+    show.add_argument("--seed", type=_positive_int, default=None, help="seed of OMPL's random numbers")
+    show.add_argument(
+        "--time-limit",
+        type=_positive("seconds"),
+        default=None,
+        help="seconds to plan (default: the problem's suggestion, else 10)",
+    )
+    show.add_argument("--trees", action="store_true", help="draw the planner's trees (nodes at the end effector)")
+    show.add_argument("--end-effector", default=None, metavar="LINK", help="the link a robot's path traces")
+    show.add_argument(
+        "--host", default="127.0.0.1", help="where the live viewer listens (default 127.0.0.1; 0.0.0.0 shares it)"
+    )
+    show.add_argument("--port", type=_whole_number, default=8080, help="its port (default 8080; 0: any free port)")
+    show.add_argument("--no-browser", action="store_true", help="do not open a browser (print the address only)")
+
+
+def _html_file(text: str) -> Path:
+    path = Path(text)
+    if path.suffix.lower() not in (".html", ".htm"):
+        raise argparse.ArgumentTypeError(f"must name an .html file, got {text!r}")
+    if not path.parent.is_dir():
+        raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
+    return path
+
+
+def _show(args: argparse.Namespace) -> int:
+    """``ompl-balance show``: plan the problem, then show it (:mod:`ompl_balance.viz`)."""
+    from .viz.command import run_show
+
+    try:
+        return run_show(
+            args.problem,
+            args.out,
+            planner=args.planner,
+            seed=args.seed,
+            time_limit=args.time_limit,
+            trees=args.trees,
+            host=args.host,
+            port=args.port,
+            open_browser=not args.no_browser,
+            end_effector=args.end_effector,
+        )
+    except ValueError as error:
+        print(f"ompl-balance show: {error}", file=sys.stderr)
+        return 2
 
 
 def _run(experiment: Experiment, out: Path, args: argparse.Namespace, temporary: bool = False) -> int:
@@ -360,6 +437,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _plot(args)
         if args.command == "gamma":
             return _gamma(args, parser)
+        if args.command == "show":
+            return _show(args)
     except (ExperimentError, MissingExtraError) as error:
         print(f"ompl-balance {args.command}: {error}", file=sys.stderr)
         return 2

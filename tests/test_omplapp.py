@@ -204,7 +204,11 @@ def test_bad_input_names_the_file_and_line(scene):
     _error(folder, replace(2, "robot = nowhere.dae"), r"problem\.cfg:3: robot = nowhere\.dae: mesh file .* not found")
     _error(folder, replace(4, "start.x 0.0"), r"problem\.cfg:5: expected 'key = value'")
     _error(folder, replace(4, "start.x = zero"), r"problem\.cfg:5: start\.x = 'zero' is not a finite number")
-    _error(folder, replace(5, "start.y = 4.0"), r"problem\.cfg:5: the start state .* is in collision with the world")
+    _error(  # naming what collides
+        folder,
+        replace(5, "start.y = 4.0"),
+        r"problem\.cfg:5: the start state .* is in collision with the world: \S+ with obstacle '.+'",
+    )
     _error(folder, [line for line in SE3_LINES if not line.startswith("goal.theta")], r"has no goal\.theta")
     _error(
         folder, [*SE3_LINES[:2], "control = blimp", *SE3_LINES[2:]], r"problem\.cfg:3: control = blimp: control-based"

@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike
 
 from ..core.checks import Count, new_counts
 from ..core.compiled_calls import entry_point
+from .contacts import OBSTACLE, SELF, Contact, geometry_names
 from .environment import Environment
 from .geometry import fcl_transform
 from .kernels import RobotStates, robot_state_free, robot_states, warm_exits_once
@@ -258,6 +259,36 @@ class CollisionChecker:
         self.counter.distance_queries += 1
         return float(fcl.distance(first, second, self._distance_request, fcl.DistanceResult()))
 
+    def collisions(self, q: ArrayLike, nearest: int = 0) -> list[Contact]:
+        """What collides at configuration ``q`` (dof,) (radians, metres): every pair of the model
+        in contact, by FCL's collision test, in pair order (see :attr:`pair_count`): link
+        geometries against obstacles, then the self-collision pairs.
+
+        When no pair is in contact and ``nearest > 0``, the ``nearest`` closest pairs instead,
+        with FCL's distances (m), closest first. Joint limits are not looked at (a configuration
+        outside them collides with nothing here, yet is not valid), and nothing is counted in
+        :attr:`counter`. ``ValueError`` for a wrong shape, a non-finite value or ``nearest < 0``.
+        """
+        rows = self.robot.as_array(q)
+        if len(rows) != 1:
+            raise ValueError(
+                f"collisions takes one configuration of {self.robot.dof} joint values, got shape {rows.shape}"
+            )
+        if nearest < 0:
+            raise ValueError(f"nearest must be a number of pairs >= 0, got {nearest}")
+        poses = self.robot.body_poses(rows)[0]
+        touching: list[int] = []
+        apart: list[tuple[float, int]] = []
+        for pair in range(self.pair_count):
+            first, second = self._pair_objects(pair, poses)
+            if self._collide(first, second):
+                touching.append(pair)
+            elif nearest:
+                apart.append((float(fcl.distance(first, second, self._distance_request, fcl.DistanceResult())), pair))
+        if touching or not nearest:
+            return [self._contact(pair, True, 0.0) for pair in touching]
+        return [self._contact(pair, False, distance) for distance, pair in sorted(apart)[:nearest]]
+
     def kernel_view(self) -> RobotStates:
         """The checker as compiled code sees it (:class:`~ompl_balance.collision.kernels.RobotStates`):
         its arrays, and the exit to :meth:`decide` for the pairs the screening leaves to FCL."""
@@ -276,6 +307,16 @@ class CollisionChecker:
         self._place(body_poses, a)
         self._place(body_poses, b)
         return self._links[a], self._links[b]
+
+    def _contact(self, pair: int, touching: bool, distance: float) -> Contact:
+        """Pair ``pair`` (see :attr:`pair_count`) as a :class:`~ompl_balance.collision.contacts.Contact`."""
+        names = geometry_names([g.link for g in self.robot.geometries])
+        environment = len(self._obstacles) * len(self._links)
+        if pair < environment:
+            o, g = divmod(pair, len(self._links))
+            return Contact(names[g], self.environment.obstacles[o].name, OBSTACLE, touching, distance, g, o)
+        a, b = self._pairs[pair - environment]
+        return Contact(names[a], names[b], SELF, touching, distance, a, b)
 
     def _screen_outputs(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Arrays :func:`~ompl_balance.collision.screening.screen` fills for ``n`` configurations:

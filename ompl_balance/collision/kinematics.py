@@ -148,6 +148,10 @@ class RobotModel:
 
         active = [j for j in robot.joints if j.type in MOVING_JOINTS and j.mimic is None]
         self.name = name
+        #: The URDF file and ROS package map the robot was read from (:meth:`from_urdf`), for
+        #: what reads more of it than collision geometry (a viewer's visual meshes); else None.
+        self.urdf_path: Path | None = None
+        self.package_map: dict[str, str] = {}
         self.joint_names: list[str] = [j.name for j in active]
         bounds = np.array([_limits(j) for j in active]).reshape(-1, 2)
         self.lower, self.upper = bounds[:, 0], bounds[:, 1]
@@ -278,7 +282,9 @@ class RobotModel:
             raise ValueError(f"cannot parse URDF {urdf_path}: no <robot> with links")
         resolve = _MeshResolver(urdf_path.parent, package_map or {})
         disabled = _srdf_disabled_pairs(Path(srdf_path)) if srdf_path is not None else set()
-        return RobotModel(urdf, lambda link: _link_shapes(link, resolve), disabled, urdf.robot.name)
+        model = RobotModel(urdf, lambda link: _link_shapes(link, resolve), disabled, urdf.robot.name)
+        model.urdf_path, model.package_map = urdf_path.resolve(), dict(package_map or {})
+        return model
 
     def as_array(self, q: ArrayLike, finite: bool = True) -> np.ndarray:
         """``q`` as a float array (n, dof); raises ``ValueError`` for a wrong shape, and for
@@ -357,6 +363,15 @@ class _MeshResolver:
             f"link {link!r}: collision mesh {filename!r} not found (tried {', '.join(map(str, tried[:4]))}"
             f"{', ...' if len(tried) > 4 else ''}); pass package_map={{'PACKAGE': '/path/to/package'}}"
         )
+
+
+def resolve_mesh_file(
+    urdf_path: str | Path, filename: str, link: str, package_map: dict[str, str] | None = None
+) -> Path:
+    """The file a URDF's mesh ``filename`` (``package://``, ``file://``, relative or absolute) names,
+    looked for as :meth:`RobotModel.from_urdf` looks for collision meshes; ``FileNotFoundError``
+    naming the places tried and ``link``."""
+    return _MeshResolver(Path(urdf_path).parent, package_map or {})(filename, link)
 
 
 def _link_shapes(link: yourdfpy.Link, resolve: _MeshResolver) -> Iterator[tuple[np.ndarray, Shape, str | None]]:

@@ -38,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..collision.contacts import describe_contacts
 from ..collision.environment import Environment
 from ..collision.rigid.body import RigidBody
 from ..collision.rigid.pieces import soup_mesh, split_triangles
@@ -203,7 +204,10 @@ def load_omplapp(cfg_path: str | Path, validate: bool = True) -> RigidBodyProble
         if not checker.inside_bounds(state):
             raise ValueError(f"{config.at(key)}: the {side} state {state.tolist()} is outside the bounds")
         if not checker.is_valid(state):
-            raise ValueError(f"{config.at(key)}: the {side} state {state.tolist()} is in collision with the world")
+            raise ValueError(
+                f"{config.at(key)}: the {side} state {state.tolist()} is in collision with the world: "
+                f"{describe_contacts(checker.collisions(state))}"
+            )
     return problem
 
 

@@ -39,6 +39,7 @@ from ..advancement import DISTANCE_TOLERANCE
 from ..bisection import bisect_segments, contact_at_middles
 from ..certified import PathCertificate
 from ..checker import WorkCounter
+from ..contacts import OBSTACLE, Contact
 from ..environment import Environment
 from ..geometry import Shape, fcl_transform
 from .advance import LAST_VALID_TRAVEL, MIN_TRAVEL, edge_status
@@ -278,6 +279,33 @@ class RigidBodyChecker:
             best = min(best, fcl.distance(part, obstacle, _DISTANCE_REQUEST, fcl.DistanceResult()))
         return float(best)
 
+    def collisions(self, state: ArrayLike, nearest: int = 0) -> list[Contact]:
+        """What collides at ``state`` ((3,) SE(2), (7,) SE(3)): every pair of a body part and an
+        obstacle in contact, by FCL's collision test, in pair order (obstacles, then parts).
+
+        When no pair is in contact and ``nearest > 0``, the ``nearest`` closest pairs instead,
+        with FCL's distances (m), closest first. The position bounds are not looked at (see
+        :meth:`inside_bounds`), and nothing is counted in :attr:`counter`. ``ValueError`` for a
+        wrong shape, a non-finite value, a non-unit quaternion or ``nearest < 0``.
+        """
+        row = self.body.as_states(self._row(state))[0]
+        if nearest < 0:
+            raise ValueError(f"nearest must be a number of pairs >= 0, got {nearest}")
+        pose = np.empty((4, 4))
+        state_pose(row, pose)
+        self._place_all(pose)
+        touching: list[int] = []
+        apart: list[tuple[float, int]] = []
+        for pair in range(len(self._obstacles) * len(self._parts)):
+            part, obstacle = self._pair_objects(pair)
+            if fcl.collide(part, obstacle, _REQUEST, fcl.CollisionResult()):
+                touching.append(pair)
+            elif nearest:
+                apart.append((float(fcl.distance(part, obstacle, _DISTANCE_REQUEST, fcl.DistanceResult())), pair))
+        if touching or not nearest:
+            return [self._contact(pair, True, 0.0) for pair in touching]
+        return [self._contact(pair, False, distance) for distance, pair in sorted(apart)[:nearest]]
+
     def inside_bounds(self, state: ArrayLike) -> bool:
         """Whether ``state`` is a valid state within the position bounds (collisions aside)."""
         return bool(valid_state(self._row(state), self.view.low, self.view.high))
@@ -316,6 +344,12 @@ class RigidBodyChecker:
 
     def _undecided(self) -> np.ndarray:
         return self.view.undecided[: self.view.counts[UNDECIDED_PAIRS]]
+
+    def _contact(self, pair: int, touching: bool, distance: float) -> Contact:
+        """Pair ``pair`` (obstacle * parts + part) as a :class:`~ompl_balance.collision.contacts.Contact`."""
+        obstacle, part = divmod(pair, len(self._parts))
+        name = self.environment.obstacles[obstacle].name
+        return Contact(self.body.parts[part].name, name, OBSTACLE, touching, distance, part, obstacle)
 
     def _count_kernel_work(self) -> None:
         counts = self.view.counts
