@@ -39,6 +39,7 @@ class Count(enum.IntEnum):
     MOTIONS = 1  # motions (edges) decided
     DISTANCE_QUERIES = 2  # exact distance queries of a certified motion validator
     EXITS = 3  # calls from compiled code to Python
+    OVER_BUDGET = 4  # motions refused because their proof would exceed the check's work budget
 
 
 def new_counts() -> np.ndarray:
