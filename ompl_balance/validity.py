@@ -7,7 +7,8 @@ Motion validators:
 
 * :class:`CertifiedMotionValidator` (the default of :func:`setup_robot`) proves each
   straight joint-space edge free of collision for the checker's model, with an optional
-  clearance (:mod:`ompl_balance.collision.certified`);
+  clearance (:mod:`ompl_balance.collision.certified`), within a work budget per edge
+  (``motion_budget``, :mod:`ompl_balance.collision.budget`);
 * :class:`MotionValidator` checks the states OMPL's ``DiscreteMotionValidator`` checks
   (``validSegmentCount`` of them), in one batch; what lies between them is not looked at.
 
@@ -26,6 +27,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from .collision.budget import MOTION_BUDGET, budget_units
 from .collision.certified import MotionCertifier, PathCertificate, certify_states
 from .collision.checker import CollisionChecker
 from .collision.kernels import (
@@ -202,11 +204,25 @@ class CertifiedMotionValidator(_RobotMotionValidator):
     invalid (OMPL's C++ caller gets ``false``, not an exception). Work is counted in the
     checker's counter: one motion per edge, the configurations evaluated as states, and
     the distance queries (GJK bounds and FCL distances).
+
+    ``motion_budget``: the most work one edge's proof may take, in work units (one per
+    configuration placed or GJK bound, :data:`~ompl_balance.collision.budget.FCL_QUERY_WORK`
+    per FCL query; ``None``: no limit). An edge that would need more is invalid (never "free"
+    unproved) and counts in the checker's ``motions_over_budget``: it bounds the cost of every
+    ``checkMotion``, which OMPL's path simplifier needs to keep its time limit
+    (:mod:`ompl_balance.collision.budget`).
     """
 
-    def __init__(self, si: ob.SpaceInformation, checker: CollisionChecker, clearance: float = 0.0):
+    def __init__(
+        self,
+        si: ob.SpaceInformation,
+        checker: CollisionChecker,
+        clearance: float = 0.0,
+        motion_budget: int | None = MOTION_BUDGET,
+    ):
+        budget_units(motion_budget)  # (its error before OMPL's constructor runs)
         super().__init__(si, checker)
-        self.certifier = MotionCertifier(checker, clearance)
+        self.certifier = MotionCertifier(checker, clearance, motion_budget=motion_budget)
 
     def compiled_view(self) -> CertifiedMotions:
         """The validator as compiled code sees it (:class:`~ompl_balance.collision.kernels.CertifiedMotions`)."""
@@ -216,6 +232,11 @@ class CertifiedMotionValidator(_RobotMotionValidator):
     def clearance(self) -> float:
         """Metres every pair keeps clear of contact along a valid edge."""
         return self.certifier.clearance
+
+    @property
+    def motion_budget(self) -> int | None:
+        """The work units one edge's proof may take (``None``: no limit)."""
+        return self.certifier.motion_budget
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         return self.certifier.check(np.array(s1[0 : self._dof]), np.array(s2[0 : self._dof]))[0]
@@ -250,25 +271,30 @@ def setup_robot(
     checker: CollisionChecker,
     motion: str = "certified",
     clearance: float = 0.0,
+    motion_budget: int | None = MOTION_BUDGET,
 ) -> tuple[StateValidityChecker, CertifiedMotionValidator | MotionValidator]:
     """Install ``checker`` as state validity checker, and a motion validator.
 
     ``ss_or_si`` is an ``og.SimpleSetup`` or an ``ob.SpaceInformation`` whose space is
     a real-vector space of the robot's dimension (e.g. from :func:`space_for`).
     ``motion`` is ``"certified"`` (:class:`CertifiedMotionValidator`, keeping
-    ``clearance`` metres) or ``"discrete"`` (:class:`MotionValidator`, OMPL's discrete
-    states only). Call before ``setup()``/``solve()``. Returns the two installed objects.
+    ``clearance`` metres, each edge's proof within ``motion_budget`` work units, ``None``
+    for no limit) or ``"discrete"`` (:class:`MotionValidator`, OMPL's discrete states only).
+    Call before ``setup()``/``solve()``. Returns the two installed objects.
     """
     if motion not in MOTION_VALIDATORS:
         raise ValueError(f"motion must be one of {', '.join(map(repr, MOTION_VALIDATORS))}, got {motion!r}")
+    budget_units(motion_budget)
     if motion == "discrete" and clearance != 0.0:
         raise ValueError(f"clearance={clearance} needs motion='certified' (the discrete validator keeps none)")
+    if motion == "discrete" and motion_budget != MOTION_BUDGET:
+        raise ValueError(f"motion_budget={motion_budget} needs motion='certified' (the discrete validator has none)")
     si = ss_or_si.getSpaceInformation() if isinstance(ss_or_si, og.SimpleSetup) else ss_or_si
     _check_dimension(si, checker)
     validity = StateValidityChecker(si, checker)
     validator: CertifiedMotionValidator | MotionValidator
     if motion == "certified":
-        validator = CertifiedMotionValidator(si, checker, clearance)
+        validator = CertifiedMotionValidator(si, checker, clearance, motion_budget)
     else:
         validator = MotionValidator(si, checker)
     si.setStateValidityChecker(validity)
@@ -277,7 +303,10 @@ def setup_robot(
 
 
 def certify_path(
-    checker: CollisionChecker | RigidBodyChecker, states: np.ndarray | og.PathGeometric, clearance: float = 0.0
+    checker: CollisionChecker | RigidBodyChecker,
+    states: np.ndarray | og.PathGeometric,
+    clearance: float = 0.0,
+    motion_budget: int | None = MOTION_BUDGET,
 ) -> PathCertificate:
     """Certify a path's straight joint-space segments for ``checker``'s model.
 
@@ -285,7 +314,9 @@ def certify_path(
     smoother's output). Returns a :class:`~ompl_balance.collision.certified.PathCertificate`:
     whether every segment is certified with ``clearance`` metres to spare, the first
     segment that is not (and how much of it is), and the smallest exact distance at the
-    path's states. Counts its work in the checker's counter.
+    path's states. Counts its work in the checker's counter. A segment whose proof would take
+    more than ``motion_budget`` work units is not certified (``None``: no limit), as the
+    certified motion validators have it.
 
     With a :class:`RigidBodyChecker` the segments are rigid-body motions along OMPL's
     interpolation and ``states`` are ``(n, 3)`` (SE(2)) or ``(n, 7)`` (SE(3)) rows.
@@ -294,11 +325,11 @@ def certify_path(
         if isinstance(states, og.PathGeometric):
             size = checker.body.state_size
             states = np.array([rigid_state_values(states.getState(i), size) for i in range(states.getStateCount())])
-        return certify_rigid_states(checker, np.asarray(states, dtype=float), clearance)
+        return certify_rigid_states(checker, np.asarray(states, dtype=float), clearance, motion_budget)
     if isinstance(states, og.PathGeometric):
         dof = checker.robot.dof
         states = np.array([states.getState(i)[0:dof] for i in range(states.getStateCount())]).reshape(-1, dof)
-    return certify_states(checker, states, clearance)
+    return certify_states(checker, states, clearance, motion_budget)
 
 
 # -- rigid bodies -------------------------------------------------------------------------
@@ -450,7 +481,9 @@ class RigidBodyCertifiedMotionValidator(_RigidBodyMotionValidator):
     line, rotation along the shortest arc); it is valid when every pair (obstacle, body part)
     of ``checker``'s model stays more than ``checker.clearance`` apart along all of it
     (:meth:`RigidBodyChecker.certify`: conservative advancement with distance lower bounds
-    against the body's travel). States that are not valid (outside the bounds, not finite)
+    against the body's travel), within the checker's work budget per motion
+    (``checker.motion_budget``: a motion whose proof would need more is invalid and counts in
+    ``motions_over_budget``). States that are not valid (outside the bounds, not finite)
     make a motion invalid. Counts in the checker's counter: one motion per edge, the poses
     evaluated as states, the distance queries.
     """
@@ -492,8 +525,9 @@ def setup_rigid_body(
 
     ``ss_or_si``: an ``og.SimpleSetup`` or ``ob.SpaceInformation`` over an ``SE2StateSpace`` or
     ``SE3StateSpace`` (e.g. from :func:`rigid_body_space`), as the body moves. ``motion``:
-    ``"certified"`` (:class:`RigidBodyCertifiedMotionValidator`, keeping ``checker.clearance``)
-    or ``"discrete"`` (:class:`RigidBodyMotionValidator`, OMPL's discrete states only). Call
+    ``"certified"`` (:class:`RigidBodyCertifiedMotionValidator`, keeping ``checker.clearance``,
+    each motion's proof within ``checker.motion_budget``) or ``"discrete"``
+    (:class:`RigidBodyMotionValidator`, OMPL's discrete states only). Call
     before ``setup()``/``solve()``. Returns the two installed objects.
     """
     if motion not in MOTION_VALIDATORS:

@@ -73,17 +73,22 @@ def random_edges(robot, oracle, count, rng, longest=1.2):
 
 def check_edges(robot, environment, edges, certifier=None):
     """Every edge: certified only if the oracle finds no collision; the lastValid fraction is at
-    or before the first collision and its prefix is free. Returns (certified, oracle-free) counts."""
+    or before the first collision and its prefix is free. Returns (certified, oracle-free) counts.
+
+    The two ways of checking (without and with lastValid) do different work, so near the work
+    budget one may refuse a free edge the other certifies."""
     oracle = CollisionChecker(robot, environment)
     certifier = certifier or certified.MotionCertifier(CollisionChecker(robot, environment))
     certified_count = free_count = 0
     for a, b in edges:
         first = dense_first_collision(oracle, a, b)
+        over_budget = certifier.checker.counters()["motions_over_budget"]
         valid, fraction = certifier.check(a, b)
         assert not (valid and first is not None), f"edge certified free collides at t = {first}: {a} -> {b}"
         assert fraction == (1.0 if valid else 0.0)
         valid_again, fraction = certifier.check(a, b, last_valid=True)
-        assert valid_again == valid or (first is None and not valid), "last_valid changed the verdict"
+        over_budget = certifier.checker.counters()["motions_over_budget"] > over_budget
+        assert valid_again == valid or (first is None and (not valid or over_budget)), "last_valid changed the verdict"
         if first is not None:  # (a start in collision: nothing is certified, fraction 0)
             assert fraction < first or fraction == first == 0.0
         if 0.0 < fraction < 1.0:
@@ -269,9 +274,10 @@ def test_self_collision_edges_panda():
 
 def test_prefilter_off_reference_agrees():
     # the reference (FCL distances only, no spheres, hulls or tables) is safe too, and both
-    # certify the clearly free edges
+    # certify the clearly free edges (the reference without a work budget: FCL on every pair
+    # over the whole edge takes far more than a check of the default budget may)
     robot, environment = arm3_scene()[:2]
-    reference = certified.MotionCertifier(CollisionChecker(robot, environment, prefilter=False))
+    reference = certified.MotionCertifier(CollisionChecker(robot, environment, prefilter=False), motion_budget=None)
     fast = certified.MotionCertifier(CollisionChecker(robot, environment))
     edges = random_edges(robot, CollisionChecker(robot, environment), 25, np.random.default_rng(9), longest=0.6)
     check_edges(robot, environment, edges, reference)
@@ -551,7 +557,9 @@ def plan_and_recheck(scenario, index, planner_class, simplify=True):
         paths.append(ss.getSolutionPath())
     for path in paths:
         states = np.array([path.getState(i)[0 : robot.dof] for i in range(path.getStateCount())])
-        assert certify_path(checker, states).certified
+        # without a work budget: a fresh certificate remembers no bounds from the planner's edges,
+        # so near the budget it may need more work for a segment than the validator did
+        assert certify_path(checker, states, motion_budget=None).certified
         for a, b in itertools.pairwise(states):
             assert dense_first_collision(oracle, a, b) is None
     return ss

@@ -24,6 +24,10 @@ segment of travel at most ``handover`` metres still fails (the *hard* segments),
 only a yes or no is wanted, as soon as their convex parts touch at a segment's end: there
 the mesh is likeliest in contact, which FCL tells in one test, and the caller may ask FCL
 before the rest of the edge is certified (``probe``).
+
+Every call has a work budget (:mod:`ompl_balance.collision.budget`): each configuration placed
+and each GJK bound costs one unit, and a proof that would need more stops there, the edge
+refused (``exhausted``).
 """
 
 from __future__ import annotations
@@ -259,8 +263,9 @@ def grown(array: np.ndarray, size: int) -> np.ndarray:  # pragma: no cover (comp
 class EdgeModel(NamedTuple):
     """What :func:`advance` certifies against, fixed for a certifier: the robot's ``chain``, the
     checker's ``volumes``, the certifier's :class:`Model`, ``clearance`` (m: pairs must stay
-    farther apart), ``handover`` (m of travel below which non-convex pairs go to FCL) and
-    ``floor`` (m: a segment failing with less travel fails the edge)."""
+    farther apart), ``handover`` (m of travel below which non-convex pairs go to FCL),
+    ``floor`` (m: a segment failing with less travel fails the edge) and ``budget``: the work
+    units one motion check may spend (:mod:`ompl_balance.collision.budget`)."""
 
     chain: Chain
     volumes: Volumes
@@ -268,6 +273,7 @@ class EdgeModel(NamedTuple):
     clearance: float
     handover: float
     floor: float
+    budget: int
 
 
 class EdgeScratch(NamedTuple):
@@ -344,6 +350,37 @@ def _parts_touch(lower: np.ndarray, final: np.ndarray, clearance: float) -> bool
     return (final[0] and lower[0] <= clearance) or (final[1] and lower[1] <= clearance)
 
 
+@njit(cache=True, inline="always")
+def _exhausted(
+    stop: bool,
+    bad: float,
+    seg_k: np.ndarray,
+    width: float,
+    first: int,
+    count: int,
+    split: np.ndarray,
+    splits: int,
+    hard: int,
+    evaluated: int,
+    bounded: int,
+    hard_pair: np.ndarray,
+    hard_span: np.ndarray,
+) -> tuple[bool, float, int, int, int, np.ndarray, np.ndarray, bool]:  # pragma: no cover (compiled)
+    """What :func:`advance` returns when its budget runs out: the edge fails, and (unless
+    ``stop``) is certified up to the least of ``bad`` and the starts of the segments still
+    unproved: those of the level not yet looked at (``first`` to ``count``), those to be halved
+    (``split[:splits]``) and the hard segments."""
+    if stop:
+        return True, 0.0, hard, evaluated, bounded, hard_pair, hard_span, True
+    for i in range(first, count):
+        bad = min(bad, seg_k[i] * width)
+    for i in range(splits):
+        bad = min(bad, seg_k[split[i]] * width)
+    for i in range(hard):
+        bad = min(bad, hard_span[i, 0])
+    return True, bad, hard, evaluated, bounded, hard_pair, hard_span, True
+
+
 @njit(cache=True)
 def advance(
     a: np.ndarray,
@@ -356,7 +393,8 @@ def advance(
     stop: bool,
     probe: bool,
     scratch: EdgeScratch,
-) -> tuple[bool, float, int, int, int, np.ndarray, np.ndarray]:  # pragma: no cover (compiled)
+    budget: int,
+) -> tuple[bool, float, int, int, int, np.ndarray, np.ndarray, bool]:  # pragma: no cover (compiled)
     """Certify the edge ``a -> b`` (dof,) for every pair but the hard segments.
 
     ``edge``: what to certify against (:class:`EdgeModel`). ``remembered`` rows ``start`` and
@@ -373,11 +411,16 @@ def advance(
     end of the first bisection level that hands such a segment over, before the rest of the
     edge is certified, for the caller to test them first.
 
+    ``budget``: the work units this call may spend. The bound: configurations placed plus GJK
+    bounds computed <= ``budget``; the unit that would exceed it is not spent, the edge fails
+    (``exhausted``) and ``bad`` moves back to the start of the first segment still unproved
+    (hard segments included: the caller does not finish them).
+
     Returns ``failed`` (an end outside the joint bounds or not finite, a contact, or a
     segment that cannot be certified), ``bad`` (the edge is certified for all pairs on
     ``[0, bad]``, hard segments aside), the number of hard segments, the numbers of
-    configurations evaluated and of GJK distance bounds computed, and the (possibly grown)
-    hard arrays.
+    configurations evaluated and of GJK distance bounds computed, the (possibly grown)
+    hard arrays, and ``exhausted``: the budget ran out (then ``failed`` too).
     """
     chain, volumes, model = edge.chain, edge.volumes, edge.model
     clearance, handover, floor = edge.clearance, edge.handover, edge.floor
@@ -387,7 +430,9 @@ def advance(
     for j in range(dof):
         for value in (a[j], b[j]):  # (NaN fails both comparisons)
             if not (model.joint_lower[j] <= value <= model.joint_upper[j]):
-                return True, 0.0, 0, 0, 0, hard_pair, hard_span
+                return True, 0.0, 0, 0, 0, hard_pair, hard_span, False
+    if budget < 2:  # (not even the two ends can be placed)
+        return True, 0.0, 0, 0, 0, hard_pair, hard_span, True
     geometries, obstacles = len(volumes.outer_radius), len(volumes.box_half)
     pairs = obstacles * geometries + len(volumes.pairs)
     delta = b - a
@@ -432,7 +477,7 @@ def advance(
                 failed = True
                 bad = min(bad, float(side))
     if failed and stop:
-        return failed, 0.0, hard, 2, 0, hard_pair, hard_span
+        return failed, 0.0, hard, 2, 0, hard_pair, hard_span, False
     count, level = pairs, 0
     evaluated, bounded = 2, 0
     touched = False  # a hard segment was handed over where its pair's convex parts touch
@@ -459,6 +504,10 @@ def advance(
             for side in (first, 1 - first):
                 if seg_final[e, side] or halve:
                     continue
+                if evaluated + bounded >= budget:  # (one more bound would exceed the budget)
+                    return _exhausted(
+                        stop, bad, seg_k, width, e, count, split, splits, hard, evaluated, bounded, hard_pair, hard_span
+                    )
                 point = seg_point[e, side]
                 target = need - seg_lower[e, 1 - side]
                 lower, upper = hull_bounds(pair, point_poses[point], volumes, model, warm, identity, simplex, target)
@@ -472,7 +521,7 @@ def advance(
                 if model.solid[pair] and upper <= contact:
                     failed = True
                     if stop:
-                        return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span
+                        return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span, False
                     bad = min(bad, point_t[point])
                 if seg_lower[e, 0] + seg_lower[e, 1] > need:
                     break
@@ -491,7 +540,7 @@ def advance(
             if travel < floor or level >= MAX_LEVEL or (failed and t0 + width >= bad and travel < settle):
                 failed = True
                 if stop:
-                    return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span
+                    return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span, False
                 bad = min(bad, t0)
                 continue
             split[splits] = e
@@ -511,6 +560,10 @@ def advance(
             last = group
             while last < splits and seg_k[order[last]] == k:
                 last += 1
+            if evaluated + bounded >= budget:  # (placing the midpoint would exceed the budget)
+                return _exhausted(
+                    stop, bad, seg_k, width, count, count, split, splits, hard, evaluated, bounded, hard_pair, hard_span
+                )
             points += 1
             point_t = grown(point_t, points)
             point_poses = grown(point_poses, points)
@@ -530,6 +583,22 @@ def advance(
                 lower, final = spheres[i], False
                 spare = spheres[i] + min(seg_lower[e, 0], seg_lower[e, 1]) - 2.0 * clearance
                 if lower < target and not (spare > 0.0 and 0.5 * speed[pair] * width <= SPHERE_REACH * spare):
+                    if evaluated + bounded >= budget:
+                        return _exhausted(
+                            stop,
+                            bad,
+                            seg_k,
+                            width,
+                            count,
+                            count,
+                            split,
+                            splits,
+                            hard,
+                            evaluated,
+                            bounded,
+                            hard_pair,
+                            hard_span,
+                        )
                     lower, upper = hull_bounds(
                         pair, point_poses[middle], volumes, model, warm, identity, simplex, target
                     )
@@ -538,7 +607,7 @@ def advance(
                     if model.solid[pair] and upper <= contact:
                         failed = True
                         if stop:
-                            return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span
+                            return failed, 0.0, hard, evaluated, bounded, hard_pair, hard_span, False
                         bad = min(bad, point_t[middle])
                 for side in range(2):
                     child = following + side
@@ -550,8 +619,8 @@ def advance(
                 following += 2
             group = last
         if probe and touched:  # (the level's contacts of convex pairs found first: they cost no FCL test)
-            return False, 0.0, hard, evaluated, bounded, hard_pair, hard_span
+            return False, 0.0, hard, evaluated, bounded, hard_pair, hard_span, False
         seg_pair, seg_k, seg_point, seg_lower, seg_final = next_pair, next_k, next_point, next_lower, next_final
         count = following
         level += 1
-    return failed, bad, hard, evaluated, bounded, hard_pair, hard_span
+    return failed, bad, hard, evaluated, bounded, hard_pair, hard_span, False

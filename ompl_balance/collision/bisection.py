@@ -16,6 +16,11 @@ often leaves a hundred or more short segments of one pair along it, and its cont
 covers a stretch of them somewhere: :func:`probe_order` tests them coarse to fine along the
 motion (its middle, its quarters, ...), which meets a stretch covering a fraction ``f`` of
 them after about ``1 / f`` tests instead of after every segment before it.
+
+The FCL queries are the expensive part, and near a grazing contact a motion needs about
+``travel / distance`` of them: the callers' ``distance`` and ``touching`` spend from the motion
+check's :class:`~ompl_balance.collision.budget.WorkBudget` before each query, and
+:func:`bisect_segments` refuses the motion when it runs out (:mod:`ompl_balance.collision.budget`).
 """
 
 from __future__ import annotations
@@ -25,6 +30,8 @@ from collections import deque
 from collections.abc import Callable, Iterable
 
 import numpy as np
+
+from .budget import OverBudgetError
 
 #: ``(pair, t0, t1, d0, d1)``: a collision pair over ``[t0, t1]`` with distance lower bounds at its ends.
 Segment = tuple[int, float, float, float, float]
@@ -88,38 +95,48 @@ def bisect_segments(
     do not certify it fails, as does one reaching a failure found earlier once it travels less
     than ``settle``. ``failed``, ``bad``: what is already known (from the kernels); without
     ``last_valid`` the answer comes at the first failure, ``(True, 0.0)``.
+
+    When ``distance`` raises :class:`~ompl_balance.collision.budget.OverBudgetError` (the motion
+    check's work budget ran out) the motion is refused: ``(True, 0.0)`` without ``last_valid``,
+    else ``bad`` moved back to the start of the first segment still unproved.
     """
     queue = deque(sorted(segments, key=lambda segment: segment[1] - segment[2]))  # widest first
-    while queue:
-        pair, t0, t1, d0, d1 = queue.popleft()
-        if t0 >= bad:
-            continue
-        travel = speed(pair) * (t1 - t0)
-        need = travel + 2.0 * allowance(pair)
-        for t in (t0, t1) if d0 <= d1 else (t1, t0):  # the smaller bound first
+    t0 = 1.0  # (the segment being worked on when the budget runs out)
+    try:
+        while queue:
+            pair, t0, t1, d0, d1 = queue.popleft()
+            if t0 >= bad:
+                continue
+            travel = speed(pair) * (t1 - t0)
+            need = travel + 2.0 * allowance(pair)
+            for t in (t0, t1) if d0 <= d1 else (t1, t0):  # the smaller bound first
+                if d0 + d1 > need:
+                    break
+                # both are lower bounds; an exact -inf (contact) is a fact
+                if t == t0:
+                    d0 = sharper(d0, distance(pair, t))
+                else:
+                    d1 = sharper(d1, distance(pair, t))
             if d0 + d1 > need:
-                break
-            # both are lower bounds; an exact -inf (contact) is a fact
-            if t == t0:
-                d0 = sharper(d0, distance(pair, t))
-            else:
-                d1 = sharper(d1, distance(pair, t))
-        if d0 + d1 > need:
-            continue
-        for t, d in ((t0, d0), (t1, d1)):
-            if d <= allowance(pair):  # (exact: the sharpening reached it)
+                continue
+            for t, d in ((t0, d0), (t1, d1)):
+                if d <= allowance(pair):  # (exact: the sharpening reached it)
+                    failed = True
+                    if not last_valid:
+                        return True, 0.0
+                    bad = min(bad, t)
+            if travel < min_travel or t0 >= bad or (failed and t1 >= bad and travel < settle):
                 failed = True
                 if not last_valid:
                     return True, 0.0
-                bad = min(bad, t)
-        if travel < min_travel or t0 >= bad or (failed and t1 >= bad and travel < settle):
-            failed = True
-            if not last_valid:
-                return True, 0.0
-            bad = min(bad, t0)
-            continue
-        middle = 0.5 * (t0 + t1)
-        dm = distance(pair, middle)
-        queue.append((pair, t0, middle, d0, dm))
-        queue.append((pair, middle, t1, dm, d1))
+                bad = min(bad, t0)
+                continue
+            middle = 0.5 * (t0 + t1)
+            dm = distance(pair, middle)
+            queue.append((pair, t0, middle, d0, dm))
+            queue.append((pair, middle, t1, dm, d1))
+    except OverBudgetError:
+        if not last_valid:
+            return True, 0.0
+        return True, min([bad, t0, *(segment[1] for segment in queue)])
     return failed, bad

@@ -61,6 +61,12 @@ their straight line in the table's two joint values crosses free cells.
 Termination: a segment with a travel bound under :data:`MIN_TRAVEL` metres that is still
 not certified makes the edge uncertified, and contacts are decided with the tolerance
 above, so grazing edges end (rejected) after a bounded number of halvings.
+
+Cost: near a grazing contact the proof needs about ``travel / distance`` segments (hundreds of
+FCL distances for a link sliding past an obstacle a fraction of a millimetre away), so every
+check has a work budget (``motion_budget``, :mod:`ompl_balance.collision.budget`): a proof that
+would exceed it stops and the edge is not certified, counted in the checker's
+``motions_over_budget``.
 """
 
 from __future__ import annotations
@@ -86,6 +92,7 @@ from .advancement import (
     sphere_bounds,
 )
 from .bisection import bisect_segments, contact_at_middles
+from .budget import MOTION_BUDGET, UNLIMITED, OverBudgetError, WorkBudget, budget_units
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
 from .kernels import CertifiedMotions, certified_edge_free, robot_states
@@ -112,17 +119,29 @@ class MotionCertifier:
     remembered:
         How many edge end configurations keep their bounds (planners extend from the
         same states again and again).
+    motion_budget:
+        The most work one check may do, in work units (:mod:`ompl_balance.collision.budget`:
+        one per configuration placed or GJK bound,
+        :data:`~ompl_balance.collision.budget.FCL_QUERY_WORK` per FCL query); an edge whose
+        proof would need more is not certified. ``None``: no limit.
 
     See the module docstring for what is certified and how.
     """
 
     def __init__(
-        self, checker: CollisionChecker, clearance: float = 0.0, handover: float = 0.01, remembered: int = 512
+        self,
+        checker: CollisionChecker,
+        clearance: float = 0.0,
+        handover: float = 0.01,
+        remembered: int = 512,
+        motion_budget: int | None = MOTION_BUDGET,
     ):
         if not (math.isfinite(clearance) and clearance >= 0.0):
             raise ValueError(f"clearance must be a finite number of metres >= 0, got {clearance}")
         if not (math.isfinite(handover) and handover > 0.0):
             raise ValueError(f"handover must be a positive number of metres, got {handover}")
+        self._budget = budget_units(motion_budget)
+        self.motion_budget = motion_budget
         self.checker = checker
         self.clearance = float(clearance)
         self.handover = float(handover)
@@ -133,7 +152,9 @@ class MotionCertifier:
         self.pair_count = checker.pair_count
         self._model = self._build_model()
         self._identity = np.eye(4).reshape(1, 4, 4)
-        self._edge = EdgeModel(robot.chain, checker.volumes, self._model, self.clearance, self.handover, MIN_TRAVEL)
+        self._edge = EdgeModel(
+            robot.chain, checker.volumes, self._model, self.clearance, self.handover, MIN_TRAVEL, self._budget
+        )
         capacity = 4 * self.pair_count + 16  # hard segments before the arrays grow
         self._scratch = EdgeScratch(
             np.zeros((self.pair_count, 3)),
@@ -153,7 +174,8 @@ class MotionCertifier:
         )
         self._row = entry_point(memory_row, (self._memory, lower))
         self._advance = entry_point(
-            advance, (lower, lower, self._edge, self._memory.bounds, 0, 1, MIN_TRAVEL, True, False, self._scratch)
+            advance,
+            (lower, lower, self._edge, self._memory.bounds, 0, 1, MIN_TRAVEL, True, False, self._scratch, self._budget),
         )
         self._edge_free = entry_point(
             certified_edge_free, (self._edge, self._memory, self._scratch, checker.counter.array, 0, lower, lower)
@@ -208,7 +230,9 @@ class MotionCertifier:
         reports fraction 0 (the compiled engine's kernel, :func:`~ompl_balance.collision.kernels.certified_edge_free`).
         With ``last_valid`` the edge is refined around its first failure to
         :data:`LAST_VALID_TRAVEL` of travel, and ``a + s (b - a)`` is certified for every ``s``
-        up to the fraction returned.
+        up to the fraction returned. A check whose proof would exceed :attr:`motion_budget`
+        stops there: not certified (with ``last_valid``, certified up to the first stretch left
+        unproved), counted in the checker's ``motions_over_budget``.
         """
         a = np.ascontiguousarray(a, dtype=float)
         b = np.ascontiguousarray(b, dtype=float)
@@ -219,15 +243,21 @@ class MotionCertifier:
             view = self._view
             free = bool(self._edge_free(view.edge, view.memory, view.scratch, view.counts, view.handle, a, b))
             return free, 1.0 if free else 0.0
-        self.checker.counter.motions_checked += 1
+        counter = self.checker.counter
+        counter.motions_checked += 1
         start, end = self._row(self._memory, a), self._row(self._memory, b)
         settle = max(MIN_TRAVEL, LAST_VALID_TRAVEL) if last_valid else MIN_TRAVEL
+        budget = WorkBudget(self._budget)
         if self.checker.prefilter:
-            failed, bad, hard, evaluated, bounded, hard_pair, hard_span = self._advance(
-                a, b, self._edge, self._memory.bounds, start, end, settle, False, False, self._scratch
+            failed, bad, hard, evaluated, bounded, hard_pair, hard_span, exhausted = self._advance(
+                a, b, self._edge, self._memory.bounds, start, end, settle, False, False, self._scratch, self._budget
             )
-            self.checker.counter.states_checked += evaluated
-            self.checker.counter.distance_queries += bounded
+            counter.states_checked += evaluated
+            counter.distance_queries += bounded
+            budget = WorkBudget(self._budget - evaluated - bounded)  # (what the FCL phase may spend)
+            if exhausted:  # (the hard segments' starts are in bad: they are not finished)
+                counter.motions_over_budget += 1
+                return False, bad if last_valid else 0.0
             if failed and bad == 0.0:
                 return False, 0.0
             if hard == 0:
@@ -245,7 +275,9 @@ class MotionCertifier:
             failed, bad = False, 1.0
             pairs = np.arange(self.pair_count)
             spans = np.tile([0.0, 1.0, -np.inf, -np.inf], (self.pair_count, 1))
-        failed, bad = self._exact_phase(a, b, pairs, spans, start, end, settle, last_valid, failed, bad)
+        failed, bad = self._exact_phase(a, b, pairs, spans, start, end, settle, last_valid, failed, bad, budget)
+        if budget.exhausted:
+            counter.motions_over_budget += 1
         if failed:
             return False, bad if last_valid else 0.0
         return True, 1.0
@@ -255,23 +287,36 @@ class MotionCertifier:
         return self._view
 
     def hard_segments_free(
-        self, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int
+        self,
+        a: np.ndarray,
+        b: np.ndarray,
+        pairs: np.ndarray,
+        spans: np.ndarray,
+        start: int,
+        end: int,
+        budget: WorkBudget | None = None,
     ) -> bool:
         """Whether FCL certifies the hard segments ``(pair, (t0, t1, d0, d1))`` that the compiled
         phase of the edge ``a -> b`` left (rows ``start``, ``end`` of the end memory); the compiled
-        kernel's exit."""
-        failed, _ = self._exact_phase(a, b, pairs, spans, start, end, MIN_TRAVEL, False, False, 1.0)
+        kernel's exit. Spends from ``budget`` (``None``: no limit); not certified when it runs out
+        (``budget.exhausted``)."""
+        budget = budget or WorkBudget(UNLIMITED)
+        failed, _ = self._exact_phase(a, b, pairs, spans, start, end, MIN_TRAVEL, False, False, 1.0, budget)
         return not failed
 
-    def hard_segments_touch(self, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray) -> bool:
+    def hard_segments_touch(
+        self, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, budget: WorkBudget | None = None
+    ) -> bool:
         """Whether FCL finds a contact in the hard segments ``(pair, (t0, t1, d0, d1))`` of the edge
         ``a -> b``: a collision test at each end whose bound is within the clearance (where the
         pair's convex parts touch), then at each middle; the compiled kernel's exit before it
-        certifies the rest of the edge."""
-        poses = self._poses_along(a, b)
+        certifies the rest of the edge. Spends from ``budget`` (``None``: no limit) and raises
+        :class:`~ompl_balance.collision.budget.OverBudgetError` when it runs out."""
+        budget = budget or WorkBudget(UNLIMITED)
+        poses = self._poses_along(a, b, budget)
         for pair, (t0, t1, d0, d1) in zip(pairs.tolist(), spans.tolist()):
             for t, bound in ((t0, d0), (t1, d1), (0.5 * (t0 + t1), -np.inf)):
-                if bound <= self.clearance and self.checker.pair_touching(pair, poses(t)):
+                if bound <= self.clearance and self._touching(pair, poses(t), budget):
                     return True
         return False
 
@@ -302,19 +347,29 @@ class MotionCertifier:
 
     # ------------------------------------------------------------------ internals
 
-    def _distance(self, pair: int, poses: np.ndarray) -> float:
-        """FCL's distance of ``pair`` at body ``poses`` less the tolerance; ``-inf`` in contact."""
-        if self.checker.pair_touching(pair, poses):
+    def _touching(self, pair: int, poses: np.ndarray, budget: WorkBudget | None = None) -> bool:
+        """FCL's collision test of ``pair`` at body ``poses``, spent from ``budget`` if given."""
+        if budget is not None:
+            budget.spend()
+        return self.checker.pair_touching(pair, poses)
+
+    def _distance(self, pair: int, poses: np.ndarray, budget: WorkBudget | None = None) -> float:
+        """FCL's distance of ``pair`` at body ``poses`` less the tolerance; ``-inf`` in contact.
+        Both FCL queries (a collision test, then the distance) are spent from ``budget`` if given."""
+        if self._touching(pair, poses, budget):
             return -np.inf
+        if budget is not None:
+            budget.spend()
         return self.checker.pair_distance(pair, poses) - DISTANCE_TOLERANCE
 
-    def _poses_along(self, a: np.ndarray, b: np.ndarray) -> Callable[[float], np.ndarray]:
+    def _poses_along(self, a: np.ndarray, b: np.ndarray, budget: WorkBudget) -> Callable[[float], np.ndarray]:
         """The body poses at fraction ``t`` of the edge ``a -> b``: ``poses(t)``, each worked out
-        (and counted as a state checked) once."""
+        (counted as a state checked, and one unit of ``budget``) once."""
         delta, poses_at = b - a, {}
 
         def poses(t: float) -> np.ndarray:
             if t not in poses_at:
+                budget.spend(1)
                 poses_at[t] = self._robot.body_poses(a + t * delta)[0]
                 self.checker.counter.states_checked += 1
             return poses_at[t]
@@ -340,15 +395,18 @@ class MotionCertifier:
         last_valid: bool,
         failed: bool,
         bad: float,
+        budget: WorkBudget,
     ) -> tuple[bool, float]:
         """Certify the hard segments (pair, (t0, t1, d0, d1)) with FCL.
 
         ``failed`` and ``bad``: what the compiled phase found (the edge certified on
         ``[0, bad]`` but for the hard segments). Returns them updated; without
         ``last_valid`` it returns at the first failure. Segments reaching a failure are
-        refined to ``settle`` metres of travel only.
+        refined to ``settle`` metres of travel only. Every configuration placed and FCL query
+        is spent from ``budget``; when it runs out the edge fails (``budget.exhausted``), with
+        ``last_valid`` certified up to the first segment left unproved.
         """
-        clearance, speed, poses = self.clearance, self._scratch.speed, self._poses_along(a, b)
+        clearance, speed, poses = self.clearance, self._scratch.speed, self._poses_along(a, b, budget)
         exact: dict[tuple[int, float], float] = {}
 
         def distance(pair: int, t: float) -> float:
@@ -356,15 +414,18 @@ class MotionCertifier:
             if known is not None and pair in known:
                 return known[pair]
             if (pair, t) not in exact:
-                exact[pair, t] = self._distance(pair, poses(t))
+                exact[pair, t] = self._distance(pair, poses(t), budget)
                 if known is not None:
                     known[pair] = exact[pair, t]
             return exact[pair, t]
 
-        # contacts first: an FCL collision test costs a few microseconds, a distance far more
-        if not last_valid and contact_at_middles(
-            0.5 * (spans[:, 0] + spans[:, 1]), lambda i, t: self.checker.pair_touching(int(pairs[i]), poses(t))
-        ):
+        # contacts first: an FCL collision test costs less than a distance
+        try:
+            if not last_valid and contact_at_middles(
+                0.5 * (spans[:, 0] + spans[:, 1]), lambda i, t: self._touching(int(pairs[i]), poses(t), budget)
+            ):
+                return True, 0.0
+        except OverBudgetError:
             return True, 0.0
         segments = [(pair, t0, t1, d0, d1) for pair, (t0, t1, d0, d1) in zip(pairs.tolist(), spans.tolist())]
         return bisect_segments(
@@ -401,8 +462,12 @@ class PathCertificate:
     clearance: float
 
 
-def certify_states(checker: CollisionChecker, states: np.ndarray, clearance: float = 0.0) -> PathCertificate:
-    """Certify the straight joint-space segments between consecutive ``states`` (n, dof).
+def certify_states(
+    checker: CollisionChecker, states: np.ndarray, clearance: float = 0.0, motion_budget: int | None = MOTION_BUDGET
+) -> PathCertificate:
+    """Certify the straight joint-space segments between consecutive ``states`` (n, dof), each
+    within ``motion_budget`` (see :class:`MotionCertifier`: a segment whose proof would exceed it
+    is not certified).
 
     Raises ``ValueError`` for a wrong shape or non-finite values; a state outside the joint
     bounds leaves its segments uncertified.
@@ -410,7 +475,7 @@ def certify_states(checker: CollisionChecker, states: np.ndarray, clearance: flo
     states = checker.robot.as_array(states)
     if len(states) == 0:
         raise ValueError("a path needs at least one state")
-    certifier = MotionCertifier(checker, clearance)
+    certifier = MotionCertifier(checker, clearance, motion_budget=motion_budget)
     first_bad, fraction = None, 1.0
     for i in range(len(states) - 1):
         ok, fraction = certifier.check(states[i], states[i + 1], last_valid=True)

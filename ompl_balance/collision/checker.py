@@ -58,7 +58,9 @@ class WorkCounter:
     ``states_checked``: configurations evaluated (a state check, a state of a discrete
     edge, a configuration a certified edge was bounded at); ``motions_checked``: edges;
     ``distance_queries``: distance bounds computed by GJK on convex hulls and FCL exact
-    distances (certified motions only). The counts live in :attr:`array` (indexed by
+    distances (certified motions only); ``motions_over_budget``: certified motions refused
+    because their proof would exceed the check's work budget
+    (:mod:`ompl_balance.collision.budget`). The counts live in :attr:`array` (indexed by
     :class:`~ompl_balance.core.checks.Count`), which compiled kernels increment in place.
     """
 
@@ -69,12 +71,14 @@ class WorkCounter:
     motions_checked = _Count(Count.MOTIONS)
     distance_queries = _Count(Count.DISTANCE_QUERIES)
     exits = _Count(Count.EXITS)  # calls from compiled code to Python (FCL)
+    motions_over_budget = _Count(Count.OVER_BUDGET)
 
     def counters(self) -> dict[str, int]:
         return {
             "states_checked": self.states_checked,
             "motions_checked": self.motions_checked,
             "distance_queries": self.distance_queries,
+            "motions_over_budget": self.motions_over_budget,
         }
 
     def reset(self) -> None:

@@ -12,7 +12,8 @@ Three views (:mod:`ompl_balance.core.checks`), each a named tuple of arrays:
   visited coarse to fine (:func:`coarse_to_fine`), FCL on those the screening leaves;
 * :class:`CertifiedMotions`: certified motions (:class:`~ompl_balance.collision.certified.MotionCertifier`):
   conservative advancement in compiled code (:func:`~ompl_balance.collision.advancement.advance`),
-  and one exit to FCL for the hard segments of non-convex pairs.
+  and one exit to FCL for the hard segments of non-convex pairs, within the certifier's work
+  budget per motion (:mod:`ompl_balance.collision.budget`).
 
 The Python validators call these same kernels (through fixed-type entry points), so a stock
 planner and the compiled engine get the same answers and the same counts. Work is counted
@@ -32,6 +33,7 @@ from ..core.compiled_spaces import segment_count
 from ..core.kernel_cache import njit
 from ..core.layout import SpaceLayout
 from .advancement import EdgeModel, EdgeScratch, EndMemory, advance, memory_row
+from .budget import OverBudgetError, WorkBudget
 from .kinematics import LIMIT_TOLERANCE, Chain
 from .screening import Volumes, screen
 
@@ -236,14 +238,28 @@ class CertifiedMotions(NamedTuple):
     counts: np.ndarray
 
 
+#: What the exits to FCL answer: no (not free, no contact), yes (free, a contact), or the
+#: motion's work budget ran out first.
+EXIT_NO, EXIT_YES, EXIT_OVER_BUDGET = 0, 1, 2
+
+
 def _exact(
-    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int
-) -> bool:
-    return bool(exit_target(handle).hard_segments_free(a, b, pairs, spans, start, end))
+    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int, left: int
+) -> int:
+    budget = WorkBudget(left)
+    free = exit_target(handle).hard_segments_free(a, b, pairs, spans, start, end, budget)
+    return EXIT_YES if free else EXIT_OVER_BUDGET if budget.exhausted else EXIT_NO
 
 
-def _touching(handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray) -> bool:
-    return bool(exit_target(handle).hard_segments_touch(a, b, pairs, spans))
+def _touching(
+    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, left: int
+) -> tuple[int, int]:
+    budget = WorkBudget(left)
+    try:
+        touching = exit_target(handle).hard_segments_touch(a, b, pairs, spans, budget)
+    except OverBudgetError:
+        return EXIT_OVER_BUDGET, budget.spent
+    return EXIT_YES if touching else EXIT_NO, budget.spent
 
 
 @njit(cache=True)
@@ -264,46 +280,65 @@ def certified_edge_free(
     Where a non-convex pair's convex parts touch, the advancement stops at the end of that
     bisection level and FCL tests those segments for a contact first (most such edges collide
     there); only if it finds none is the edge certified in full.
+
+    The bound: the work of the whole check (both advancement passes and the FCL queries of the
+    exits, :mod:`ompl_balance.collision.budget`) <= ``edge.budget``; a check that would need
+    more refuses the motion and counts in ``counts[Count.OVER_BUDGET]``.
     """
     counts[Count.MOTIONS] += 1
     start, end = memory_row(memory, a), memory_row(memory, b)
+    spent = 0
     for probe in (True, False):
-        failed, bad, hard, evaluated, bounded, hard_pair, hard_span = advance(
-            a, b, edge, memory.bounds, start, end, edge.floor, True, probe, scratch
+        failed, bad, hard, evaluated, bounded, hard_pair, hard_span, exhausted = advance(
+            a, b, edge, memory.bounds, start, end, edge.floor, True, probe, scratch, edge.budget - spent
         )
         counts[Count.STATES] += evaluated
         counts[Count.DISTANCE_QUERIES] += bounded
+        spent += evaluated + bounded
+        if exhausted:
+            counts[Count.OVER_BUDGET] += 1
+            return False
         if failed:
             return False
         if bad == 1.0:  # certified but for the hard segments
             break
         counts[Count.EXITS] += 1  # undecided at a touching segment: FCL looks there first
-        if hard_segments_touch(handle, a, b, hard_pair[:hard], hard_span[:hard]):
+        touching, used = hard_segments_touch(handle, a, b, hard_pair[:hard], hard_span[:hard], edge.budget - spent)
+        spent += used
+        if touching == EXIT_OVER_BUDGET:
+            counts[Count.OVER_BUDGET] += 1
+        if touching != EXIT_NO:
             return False
     if hard == 0:
         return True
     counts[Count.EXITS] += 1
-    return hard_segments_free(handle, a, b, hard_pair[:hard], hard_span[:hard], start, end)
+    free = hard_segments_free(handle, a, b, hard_pair[:hard], hard_span[:hard], start, end, edge.budget - spent)
+    if free == EXIT_OVER_BUDGET:
+        counts[Count.OVER_BUDGET] += 1
+    return free == EXIT_YES
 
 
 @njit(cache=True)
 def hard_segments_free(
-    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int
-) -> bool:  # pragma: no cover (compiled)
-    """The exit to the certifier behind ``handle``: FCL on the hard segments of ``a -> b``."""
-    with objmode(free="boolean"):
-        free = _exact(handle, a, b, pairs, spans, start, end)
+    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int, left: int
+) -> int:  # pragma: no cover (compiled)
+    """The exit to the certifier behind ``handle``: FCL on the hard segments of ``a -> b`` with
+    ``left`` work units: :data:`EXIT_YES` (certified), :data:`EXIT_NO` or :data:`EXIT_OVER_BUDGET`."""
+    with objmode(free="int64"):
+        free = _exact(handle, a, b, pairs, spans, start, end, left)
     return free
 
 
 @njit(cache=True)
 def hard_segments_touch(
-    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray
-) -> bool:  # pragma: no cover (compiled)
-    """The exit to the certifier behind ``handle``: whether FCL finds a contact in the hard segments of ``a -> b``."""
-    with objmode(touching="boolean"):
-        touching = _touching(handle, a, b, pairs, spans)
-    return touching
+    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, left: int
+) -> tuple[int, int]:  # pragma: no cover (compiled)
+    """The exit to the certifier behind ``handle``: whether FCL finds a contact in the hard segments
+    of ``a -> b`` with ``left`` work units (:data:`EXIT_YES`, :data:`EXIT_NO` or
+    :data:`EXIT_OVER_BUDGET`), and the work units it spent."""
+    with objmode(touching="int64", spent="int64"):
+        touching, spent = _touching(handle, a, b, pairs, spans, left)
+    return touching, spent
 
 
 @njit(cache=True)
@@ -349,6 +384,7 @@ def warm_up() -> None:
     from ..core.checks import new_counts
     from ..core.layout import Leaf
     from .advancement import MIN_TRAVEL, Model, end_memory
+    from .budget import MOTION_BUDGET
     from .convex import pack_parts
     from .screening import stand_ins
 
@@ -394,7 +430,7 @@ def warm_up() -> None:
         joint_lower=q,
         joint_upper=q,
     )
-    edge = EdgeModel(chain, volumes, model, 0.0, 0.01, MIN_TRAVEL)
+    edge = EdgeModel(chain, volumes, model, 0.0, 0.01, MIN_TRAVEL, MOTION_BUDGET)
     scratch = EdgeScratch(
         np.zeros((0, 3)), np.zeros((4, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), np.zeros((1, 4))
     )
@@ -440,5 +476,5 @@ def warm_exits() -> None:
         np.zeros((0, 0), dtype=np.bool_),
         np.zeros(0, dtype=np.bool_),
     )
-    hard_segments_free(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)), 0, 1)
-    hard_segments_touch(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)))
+    hard_segments_free(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)), 0, 1, 1)
+    hard_segments_touch(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)), 1)

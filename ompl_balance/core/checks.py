@@ -47,7 +47,8 @@ class Count(enum.IntEnum):
     MOTIONS = 1  # motions (edges) decided
     DISTANCE_QUERIES = 2  # exact distance queries of a certified motion validator
     EXITS = 3  # calls from compiled code to Python
-    RAISED = 4  # 1 while a check has raised and the error is not yet reported (see raised())
+    OVER_BUDGET = 4  # motions refused because their proof would exceed the check's work budget
+    RAISED = 5  # 1 while a check has raised and the error is not yet reported (the engine raises it)
 
 
 def new_counts() -> np.ndarray:

@@ -37,6 +37,7 @@ import trimesh
 from ompl import base as ob
 from ompl import geometric as og
 
+from ..collision.budget import MOTION_BUDGET
 from ..collision.environment import Environment
 from ..collision.rigid.body import RigidBody
 from ..collision.rigid.checker import RigidBodyChecker
@@ -77,9 +78,13 @@ class RigidBodyProblem:
         """``"SE2"`` or ``"SE3"``."""
         return self.body.space
 
-    def checker(self, clearance: float = 0.0) -> RigidBodyChecker:
-        """A new checker for this problem (its own work counter), with the problem's bounds."""
-        return RigidBodyChecker(self.body, self.environment, (self.low, self.high), clearance=clearance)
+    def checker(self, clearance: float = 0.0, motion_budget: int | None = MOTION_BUDGET) -> RigidBodyChecker:
+        """A new checker for this problem (its own work counter), with the problem's bounds; its
+        certified motions keep ``clearance`` within ``motion_budget`` work units each (see
+        :class:`~ompl_balance.collision.rigid.checker.RigidBodyChecker`)."""
+        return RigidBodyChecker(
+            self.body, self.environment, (self.low, self.high), clearance=clearance, motion_budget=motion_budget
+        )
 
     def simple_setup(self, motion: str = "certified", checker: RigidBodyChecker | None = None) -> og.SimpleSetup:
         """An ``og.SimpleSetup`` over OMPL's ``SE2StateSpace``/``SE3StateSpace`` with the problem's

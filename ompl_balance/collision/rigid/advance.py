@@ -26,7 +26,9 @@ hull may touch where the mesh does not) with at most ``view.handover`` of travel
 uncertified, or whose hulls overlap at an end (the hulls cannot certify them), are left to FCL's
 exact distance in ``view.hard`` (``UNDECIDED``). A segment still
 uncertified with less than :data:`MIN_TRAVEL` (times the scale) of travel refuses the motion, so
-the kernel always terminates.
+the kernel always terminates. Its cost is bounded too: each pose evaluated and each GJK bound
+spends one unit of the view's ``budget`` (:mod:`ompl_balance.collision.budget`), and a proof that
+would need more refuses the motion (``view.counts[OVER_BUDGET]``).
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from .view import (
     COLLIDING,
     FREE,
     HARD_SEGMENTS,
+    OVER_BUDGET,
     POSES_EVALUATED,
     UNDECIDED,
     RigidView,
@@ -58,6 +61,36 @@ MIN_TRAVEL = 1e-7
 LAST_VALID_TRAVEL = 1e-3
 
 
+@njit(cache=True, inline="always")
+def _exhausted(
+    view: RigidView,
+    last_valid: bool,
+    bad: float,
+    seg_t: np.ndarray,
+    first: int,
+    tail: int,
+    hard: int,
+    overflow: bool,
+    poses: int,
+    bounded: int,
+) -> tuple[int, float]:  # pragma: no cover (compiled)
+    """What :func:`edge_status` returns when its budget runs out: ``COLLIDING``, flagged in
+    ``view.counts[OVER_BUDGET]``; with ``last_valid`` certified up to the least of ``bad`` and
+    the starts of the segments still unproved (``seg_t[first:tail]`` and the hard segments;
+    hard segments that did not fit leave nothing certified)."""
+    counts = view.counts
+    counts[OVER_BUDGET], counts[HARD_SEGMENTS] = 1, 0
+    counts[POSES_EVALUATED], counts[BOUNDS_COMPUTED] = poses, bounded
+    if not last_valid or overflow:
+        bad = 0.0
+    for i in range(first, tail):
+        bad = min(bad, seg_t[i, 0])
+    for i in range(hard):
+        bad = min(bad, view.hard[i, 1])
+    view.reached[0] = bad
+    return COLLIDING, bad
+
+
 @njit(cache=True)
 def edge_status(
     view: RigidView, a: np.ndarray, b: np.ndarray, last_valid: bool
@@ -71,11 +104,19 @@ def edge_status(
     segments left in ``view.hard[:view.counts[1]]`` (``(pair, t0, t1, d0, d1)``; ``counts[1]`` is
     -1 when they did not fit, and then every pair needs FCL), certified on ``[0, fraction]`` up
     to them (``fraction`` is also left in ``view.reached[0]``). ``view.counts[2]`` and ``[3]``: poses evaluated and GJK bounds computed.
+
+    The bound: poses evaluated plus GJK bounds computed <= ``view.budget``. A proof that would
+    need more stops before the unit that would exceed it: ``COLLIDING`` with
+    ``view.counts[OVER_BUDGET]`` set, with ``last_valid`` certified up to the first segment
+    left unproved (:func:`_exhausted`).
     """
     counts = view.counts
-    counts[HARD_SEGMENTS], counts[POSES_EVALUATED], counts[BOUNDS_COMPUTED] = 0, 0, 0
+    counts[HARD_SEGMENTS], counts[POSES_EVALUATED], counts[BOUNDS_COMPUTED], counts[OVER_BUDGET] = 0, 0, 0, 0
     if len(a) != len(b) or not (valid_state(a, view.low, view.high) and valid_state(b, view.low, view.high)):
         return COLLIDING, 0.0
+    budget = view.budget
+    if budget < 2:  # (not even the two ends can be placed)
+        return _exhausted(view, last_valid, 0.0, np.empty((0, 2)), 0, 0, 0, False, 0, 0)
     translation, angle, jump = motion_split(a, b)
     parts = len(view.part_radius)
     clearance, solid = view.clearance, view.solid
@@ -144,6 +185,8 @@ def edge_status(
         for side in (first, 1 - first):
             if seg_final[e, side]:
                 continue
+            if len(known) + bounded >= budget:  # (one more bound would exceed the budget)
+                return _exhausted(view, last_valid, bad, seg_t, e, tail, hard, overflow, len(known), bounded)
             point = seg_point[e, side]
             target = need - seg_d[e, 1 - side]
             lower, upper = hull_bound(view, point_pose[point : point + 1], pair, target)
@@ -179,6 +222,8 @@ def edge_status(
             continue
         middle = 0.5 * (t0 + t1)
         if middle not in known:
+            if len(known) + bounded >= budget:  # (placing the midpoint would exceed the budget)
+                return _exhausted(view, last_valid, bad, seg_t, e, tail, hard, overflow, len(known), bounded)
             index = len(known)
             point_t = grown(point_t, index + 1)
             point_pose = grown(point_pose, index + 1)

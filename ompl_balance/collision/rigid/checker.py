@@ -16,7 +16,9 @@ among the obstacles of an :class:`~ompl_balance.collision.environment.Environmen
   both are meshes). "Certified" means every pair stays more than
   ``clearance`` apart at every point of the motion, for the model FCL tests (meshes that are
   convex count as their solid hulls; every exact distance is taken less
-  :data:`~ompl_balance.collision.advancement.DISTANCE_TOLERANCE` times the view's scale).
+  :data:`~ompl_balance.collision.advancement.DISTANCE_TOLERANCE` times the view's scale),
+  each motion within a work budget (``motion_budget``, :mod:`ompl_balance.collision.budget`:
+  a proof that would need more refuses the motion, counted in ``motions_over_budget``).
 
 The compiled view (:attr:`RigidBodyChecker.view`, a
 :class:`~ompl_balance.collision.rigid.view.RigidView`) lets a compiled planning loop call the
@@ -37,6 +39,7 @@ from numpy.typing import ArrayLike
 from ...core.compiled_calls import entry_point
 from ..advancement import DISTANCE_TOLERANCE
 from ..bisection import bisect_segments, contact_at_middles
+from ..budget import MOTION_BUDGET, OverBudgetError, WorkBudget, budget_units
 from ..certified import PathCertificate
 from ..checker import WorkCounter
 from ..contacts import OBSTACLE, Contact
@@ -52,6 +55,7 @@ from .view import (
     COLLIDING,
     FREE,
     HARD_SEGMENTS,
+    OVER_BUDGET,
     POSES_EVALUATED,
     UNDECIDED,
     UNDECIDED_PAIRS,
@@ -87,6 +91,11 @@ class RigidBodyChecker:
         Distance certified motions keep from every obstacle (0: touching is contact).
     prefilter:
         ``False``: FCL on every pair, motions by FCL distances only (the reference).
+    motion_budget:
+        The most work one certified motion may take, in work units (one per pose evaluated or
+        GJK bound, :data:`~ompl_balance.collision.budget.FCL_QUERY_WORK` per FCL query;
+        :mod:`ompl_balance.collision.budget`): a motion whose proof would need more is not
+        certified. ``None``: no limit.
     """
 
     def __init__(
@@ -97,9 +106,12 @@ class RigidBodyChecker:
         spheres_per_part: int = 8,
         clearance: float = 0.0,
         prefilter: bool = True,
+        motion_budget: int | None = MOTION_BUDGET,
     ) -> None:
         if not (math.isfinite(clearance) and clearance >= 0.0):
             raise ValueError(f"clearance must be a finite distance >= 0, got {clearance}")
+        budget = budget_units(motion_budget)
+        self.motion_budget = motion_budget
         self.body = body
         self.environment = environment or Environment()
         self.prefilter = prefilter
@@ -130,7 +142,7 @@ class RigidBodyChecker:
             self._whole_world = fcl.CollisionObject(soup_mesh_geometry(triangles), fcl.Transform())
         low3, high3 = np.full(3, -np.inf), np.full(3, np.inf)
         low3[: len(self.bounds[0])], high3[: len(self.bounds[1])] = self.bounds
-        self.view: RigidView = build_view(body, obstacles, low3, high3, spheres_per_part, clearance)
+        self.view: RigidView = build_view(body, obstacles, low3, high3, spheres_per_part, clearance, budget)
         """The compiled view: geometry and work arrays for the kernels (see :mod:`~ompl_balance.collision.rigid.view`)."""
         # the kernels are called without numba's type dispatch; argument types are fixed here
         state = np.zeros(body.state_size)
@@ -228,11 +240,14 @@ class RigidBodyChecker:
         fraction returned. Where ``view.probe`` says so (body and world all meshes), a motion
         without ``last_valid`` is first probed at a few states
         (:func:`~ompl_balance.collision.rigid.kernels.probe_free`), which count as checked.
+        A proof that would exceed :attr:`motion_budget` stops: not certified (with
+        ``last_valid``, certified up to the first stretch left unproved), counted in
+        ``motions_over_budget``.
         """
         a, b = self._row(a), self._row(b)
         self.counter.motions_checked += 1
         if not self.prefilter:
-            return self._finish_edge(a, b, self._whole_edge(), 1.0, False, last_valid)
+            return self._finish_edge(a, b, self._whole_edge(), 1.0, False, last_valid, WorkBudget(self.view.budget))
         if self.view.probe and not last_valid and not self._probe_kernel(self._states_view, a, b):
             return False, 0.0
         status, fraction = self._edge_kernel(self.view, a, b, last_valid)
@@ -250,19 +265,22 @@ class RigidBodyChecker:
         FCL's collision test of the pairs it left (``view.undecided``), with the body at
         ``view.pose[0]``; returns ``(free, 1.0 if free else 0.0)``. ``decide(a, b, last_valid)``
         after :func:`~ompl_balance.collision.rigid.advance.edge_status` ``(view, a, b,
-        last_valid)``: FCL's exact distances finish the segments it left (``view.hard``); returns
-        ``(certified, fraction)`` as :meth:`certify` does. Counts the FCL work (distance queries
-        and poses evaluated), not the state or motion itself.
+        last_valid)``: FCL's exact distances finish the segments it left (``view.hard``) with what
+        is left of the motion's work budget; returns ``(certified, fraction)`` as :meth:`certify`
+        does. Counts the FCL work (distance queries and poses evaluated), not the state or motion
+        itself, and the motion in ``motions_over_budget`` when the budget runs out.
         """
         if b is None:
             free = self._free_pairs(self.view.pose[0], self._undecided())
             return free, 1.0 if free else 0.0
         a, b = self._row(a), self._row(b)
-        hard, bad = int(self.view.counts[HARD_SEGMENTS]), float(self.view.reached[0])
+        counts = self.view.counts
+        hard, bad = int(counts[HARD_SEGMENTS]), float(self.view.reached[0])
+        budget = WorkBudget(self.view.budget - int(counts[POSES_EVALUATED]) - int(counts[BOUNDS_COMPUTED]))
         if hard < 0:  # more than the view holds: every pair over the whole motion
-            return self._finish_edge(a, b, self._whole_edge(), 1.0, False, last_valid)
+            return self._finish_edge(a, b, self._whole_edge(), 1.0, False, last_valid, budget)
         segments = [tuple(row) for row in self.view.hard[:hard].tolist()]
-        return self._finish_edge(a, b, segments, bad, bad < 1.0, last_valid)
+        return self._finish_edge(a, b, segments, bad, bad < 1.0, last_valid, budget)
 
     def closest(self, state: ArrayLike) -> float:
         """The smallest FCL distance between the body and an obstacle at ``state`` (at most 0 in
@@ -355,6 +373,8 @@ class RigidBodyChecker:
         counts = self.view.counts
         self.counter.states_checked += int(counts[POSES_EVALUATED])
         self.counter.distance_queries += int(counts[BOUNDS_COMPUTED])
+        if counts[OVER_BUDGET]:
+            self.counter.motions_over_budget += 1
 
     def _pair_objects(self, pair: int) -> tuple[fcl.CollisionObject, fcl.CollisionObject]:
         obstacle, part = divmod(pair, len(self._parts))
@@ -419,6 +439,7 @@ class RigidBodyChecker:
         bad: float,
         failed: bool,
         last_valid: bool,
+        budget: WorkBudget,
     ) -> tuple[bool, float]:
         """Certify ``segments`` ``(pair, t0, t1, d0, d1)`` of the motion ``a -> b`` with FCL.
 
@@ -427,7 +448,9 @@ class RigidBodyChecker:
         (contact: ``-inf``) as the bounds; returns ``(certified, fraction)``. When body and world
         are both meshes, the segments' spans are certified for the whole body against the whole
         world instead (pair :data:`WHOLE`: one distance per pose bounds every pair, travelling at
-        the body's reach).
+        the body's reach). Each pose evaluated and FCL query is spent from ``budget``; when it
+        runs out the motion is not certified (with ``last_valid``, up to the first segment left
+        unproved) and counts in ``motions_over_budget``.
         """
         view, counter = self.view, self.counter
         low, high = view.low, view.high
@@ -450,6 +473,7 @@ class RigidBodyChecker:
 
         def pose_at(t: float) -> np.ndarray:
             if t not in poses:
+                budget.spend(1)
                 interpolate(a, b, t, state)
                 poses[t] = np.empty((4, 4))
                 state_pose(state, poses[t])
@@ -468,7 +492,9 @@ class RigidBodyChecker:
 
         def touching(pair: int, t: float) -> bool:
             if (pair, t) not in touches:
-                touches[pair, t] = fcl.collide(*placed(pair, t), _REQUEST, fcl.CollisionResult())
+                objects = placed(pair, t)
+                budget.spend()
+                touches[pair, t] = fcl.collide(*objects, _REQUEST, fcl.CollisionResult())
             return touches[pair, t]
 
         def distance(pair: int, t: float) -> float:
@@ -479,8 +505,10 @@ class RigidBodyChecker:
                 elif touching(pair, t):
                     exact[pair, t] = -np.inf
                 else:
+                    objects = placed(pair, t)
+                    budget.spend()
                     counter.distance_queries += 1
-                    found = fcl.distance(*placed(pair, t), _DISTANCE_REQUEST, fcl.DistanceResult())
+                    found = fcl.distance(*objects, _DISTANCE_REQUEST, fcl.DistanceResult())
                     exact[pair, t] = found - DISTANCE_TOLERANCE * scale
                 if end is not None:
                     ends[end] = exact[pair, t]
@@ -490,9 +518,14 @@ class RigidBodyChecker:
 
         # contacts first: a collision test is cheaper than a distance, which a segment its ends
         # certify never needs at its middle
-        if not last_valid and contact_at_middles(
-            np.array([0.5 * (t0 + t1) for _, t0, t1, _, _ in segments]), lambda i, t: touching(int(segments[i][0]), t)
-        ):
+        try:
+            if not last_valid and contact_at_middles(
+                np.array([0.5 * (t0 + t1) for _, t0, t1, _, _ in segments]),
+                lambda i, t: touching(int(segments[i][0]), t),
+            ):
+                return False, 0.0
+        except OverBudgetError:
+            counter.motions_over_budget += 1
             return False, 0.0
         parts = len(self._parts)
 
@@ -510,6 +543,8 @@ class RigidBodyChecker:
             failed,
             bad,
         )
+        if budget.exhausted:
+            counter.motions_over_budget += 1
         if failed:
             return False, bad if last_valid else 0.0
         return True, 1.0
@@ -538,22 +573,34 @@ def _spans(segments: list[tuple[Any, ...]]) -> list[tuple[float, float]]:
     return spans
 
 
-def certify_rigid_states(checker: RigidBodyChecker, states: np.ndarray, clearance: float = 0.0) -> PathCertificate:
+def certify_rigid_states(
+    checker: RigidBodyChecker,
+    states: np.ndarray,
+    clearance: float = 0.0,
+    motion_budget: int | None = MOTION_BUDGET,
+) -> PathCertificate:
     """Certify the motions between consecutive ``states`` (n, 3) or (n, 7) for ``checker``'s model.
 
     As :func:`~ompl_balance.collision.certified.certify_states` does for robots: every motion
-    (OMPL's interpolation) certified with ``clearance`` to spare, the first that is not and how
-    much of it is, and the smallest FCL distance at the states. Work is counted in ``checker``'s
-    counter. ``ValueError`` for a wrong shape, non-finite values or non-unit quaternions; a state
-    outside the position bounds leaves its motions uncertified.
+    (OMPL's interpolation) certified with ``clearance`` to spare, each within ``motion_budget``
+    work units (a motion whose proof would need more is not certified), the first that is not
+    and how much of it is, and the smallest FCL distance at the states. Work is counted in
+    ``checker``'s counter. ``ValueError`` for a wrong shape, non-finite values or non-unit
+    quaternions; a state outside the position bounds leaves its motions uncertified.
     """
     rows = checker.body.as_states(states)
     if len(rows) == 0:
         raise ValueError("a path needs at least one state")
     certifier = checker
-    if clearance != checker.clearance:
+    if clearance != checker.clearance or motion_budget != checker.motion_budget:
         certifier = RigidBodyChecker(
-            checker.body, checker.environment, checker.bounds, checker.spheres_per_part, clearance, checker.prefilter
+            checker.body,
+            checker.environment,
+            checker.bounds,
+            checker.spheres_per_part,
+            clearance,
+            checker.prefilter,
+            motion_budget,
         )
         certifier.counter = checker.counter
     first_bad, fraction = None, 1.0

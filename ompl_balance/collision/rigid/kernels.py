@@ -21,7 +21,7 @@ from ...core.checks import Count, exit_handle, exit_target, kernels_in
 from ...core.kernel_cache import njit
 from .advance import edge_status
 from .motion import interpolate, motion_split
-from .view import BOUNDS_COMPUTED, FREE, POSES_EVALUATED, UNDECIDED, RigidView, state_status
+from .view import BOUNDS_COMPUTED, FREE, OVER_BUDGET, POSES_EVALUATED, UNDECIDED, RigidView, state_status
 
 
 @kernels_in("ompl_balance.collision.rigid.kernels")
@@ -130,7 +130,8 @@ def rigid_certified_motion_free(
 ) -> bool:  # pragma: no cover (compiled)
     """:meth:`RigidBodyChecker.certify` of ``a -> b`` without ``last_valid`` (probed first where
     ``probe`` says so); counts one motion, the probed states, the poses the edge was bounded at
-    (as states) and the distance bounds."""
+    (as states) and the distance bounds, and the motion in ``counts[Count.OVER_BUDGET]`` when
+    the edge kernel ran out of its work budget (the FCL exit counts its own)."""
     states = view.states
     counts, rigid = view.counts, states.rigid
     counts[Count.MOTIONS] += 1
@@ -139,6 +140,7 @@ def rigid_certified_motion_free(
     status, _fraction = edge_status(rigid, a, b, False)
     counts[Count.STATES] += rigid.counts[POSES_EVALUATED]
     counts[Count.DISTANCE_QUERIES] += rigid.counts[BOUNDS_COMPUTED]
+    counts[Count.OVER_BUDGET] += rigid.counts[OVER_BUDGET]
     if status != UNDECIDED:
         return status == FREE
     counts[Count.EXITS] += 1

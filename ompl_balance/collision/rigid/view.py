@@ -43,8 +43,9 @@ if TYPE_CHECKING:
 FREE, COLLIDING, UNDECIDED = 0, 1, 2
 
 #: ``counts`` entries: pairs :func:`state_status` left to FCL; hard segments ``edge_status``
-#: left (-1: more than ``hard`` holds); poses evaluated and GJK bounds computed by the last call.
-UNDECIDED_PAIRS, HARD_SEGMENTS, POSES_EVALUATED, BOUNDS_COMPUTED = 0, 1, 2, 3
+#: left (-1: more than ``hard`` holds); poses evaluated and GJK bounds computed by the last call;
+#: 1 when the last ``edge_status`` refused its motion because its work budget ran out.
+UNDECIDED_PAIRS, HARD_SEGMENTS, POSES_EVALUATED, BOUNDS_COMPUTED, OVER_BUDGET = 0, 1, 2, 3, 4
 
 
 class RigidView(NamedTuple):
@@ -72,14 +73,15 @@ class RigidView(NamedTuple):
     few states along the way (on when body and world are all meshes, see
     :func:`~ompl_balance.collision.rigid.kernels.probe_free`). ``clearance``: what certified motions
     keep; ``handover``: travel below which a non-solid pair's segment goes to FCL; ``scale``:
-    the length scale of the tolerances (``max(1, reach)``).
+    the length scale of the tolerances (``max(1, reach)``); ``budget``: the work units one
+    certified motion may spend (:mod:`ompl_balance.collision.budget`).
 
     Work arrays (written by the kernels): ``pose`` (1, 4, 4), ``identity`` (1, 4, 4), ``warm``
     (P, 3) last GJK direction per pair, ``simplex`` (4, 3) GJK's working simplex,
     ``placed_part`` (G, 3) and ``placed_sphere`` (S, 3) the spheres' world centres at ``pose``, ``undecided`` (P,) pairs left to FCL by
     :func:`state_status`, ``hard`` (H, 5) segments ``(pair, t0, t1, d0, d1)`` left to FCL by
     ``edge_status``, ``reached`` (1,) the fraction of the motion ``edge_status`` certified up to
-    them, ``counts`` (4,) (see :data:`UNDECIDED_PAIRS` and after).
+    them, ``counts`` (5,) (see :data:`UNDECIDED_PAIRS` and after).
     """
 
     dimension: int
@@ -106,6 +108,7 @@ class RigidView(NamedTuple):
     clearance: float
     handover: float
     scale: float
+    budget: int
     pose: np.ndarray
     identity: np.ndarray
     warm: np.ndarray
@@ -130,8 +133,10 @@ def build_view(
     high: np.ndarray,
     spheres_per_part: int,
     clearance: float,
+    budget: int,
 ) -> RigidView:
-    """The :class:`RigidView` of ``body`` among ``obstacles`` within position bounds ``low``/``high`` (3,)."""
+    """The :class:`RigidView` of ``body`` among ``obstacles`` within position bounds ``low``/``high`` (3,),
+    certified motions keeping ``clearance`` within ``budget`` work units each."""
     outer, small, hulls = [], [], []
     for part in body.parts:
         centres, radii = part.shape.bounding_spheres(1)
@@ -179,6 +184,7 @@ def build_view(
         clearance=float(clearance),
         handover=HANDOVER * reach,
         scale=max(1.0, reach),
+        budget=int(budget),
         pose=np.eye(4).reshape(1, 4, 4).copy(),
         identity=np.eye(4).reshape(1, 4, 4),
         warm=np.zeros((pairs, 3)),
@@ -188,7 +194,7 @@ def build_view(
         undecided=np.zeros(pairs, dtype=np.int64),
         hard=np.zeros((max(64, 16 * pairs), 5)),
         reached=np.ones(1),
-        counts=np.zeros(4, dtype=np.int64),
+        counts=np.zeros(5, dtype=np.int64),
     )
 
 
