@@ -76,7 +76,9 @@ class RunStats:
         ``sample()`` returning ``False``).
     sampler_checks: validity checks made inside the valid-state sampler (part of
         ``states_checked``, not in addition to it).
-    engine: the loop that ran, ``"compiled"`` or ``"python"``.
+    engine: the loop that ran, ``"compiled"`` or ``"python"``; ``"python, then compiled"`` for a
+        solve with ``engine=auto`` that began on Python and went on compiled once the compiled
+        engine had loaded (the same trees as on either engine alone).
     checks: how the compiled engine made the checks: ``"kernel"`` (the checker's compiled
         kernels) or ``"python"`` (``si.isValid``/``si.checkMotion``); ``"python"`` on the Python engine.
     exits: calls from compiled code out to Python (FCL queries a kernel cannot decide, a
@@ -308,12 +310,18 @@ class BalancedRRTConnect(TreePlanner):
         )
         solve = self._solve(points, rng, inputs, goal)
         compiled = self._compiled_engine(solve)
+        engine, checks = "compiled", "python"
         if compiled is None:
-            status = python_loop.run(solve, ptc)
-            engine, checks = "python", "python"
-        else:
+            # engine=auto while the compiled engine loads: it takes over once loaded
+            loaded = (lambda: self._compiled_engine(solve) is not None) if self.settings.engine == "auto" else None
+            result_status = python_loop.run(solve, ptc, loaded)
+            if result_status is None:
+                compiled, engine = self._compiled_engine(solve), "python, then compiled"
+                assert compiled is not None  # (loaded: it stays so)
+            else:
+                status, engine = result_status, "python"
+        if compiled is not None:
             status, checks = compiled(ptc)
-            engine = "compiled"
         self._distance_between_trees = solve.tree_gap
         if status == ob.PlannerStatus.EXACT_SOLUTION:
             assert solve.connection is not None

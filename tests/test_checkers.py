@@ -8,7 +8,6 @@ re-check of OMPL's lastValid rule, and the function's own calls.
 from __future__ import annotations
 
 import itertools
-import math
 import re
 import signal
 import subprocess
@@ -506,18 +505,21 @@ def test_ctrl_c_during_a_solve_with_a_numba_function():
     assert time.perf_counter() - began < 20.0
 
 
-def test_stock_planners_get_the_same_paths_checked():
-    """A stock planner with setup_checker's checker and validator: its path is valid under a dense
-    re-check with the function (OMPL's rule through the package's validator)."""
+def test_stock_planners_get_paths_valid_by_ompls_own_rule():
+    """A stock planner with setup_checker's checker and validator: every motion of its path is
+    valid for OMPL's own DiscreteMotionValidator with the same test as a plain callable."""
+    reference, _ = ompl_reference(state_free)
+    start, end = reference.allocState(), reference.allocState()
     for kind in KINDS:
         ss = make(kind)()
+        ss.getSpaceInformation().setStateValidityCheckingResolution(0.01)
         ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
         assert ss.solve(10.0)
         path = ss.getSolutionPath()
-        states = [np.array([path.getState(i)[0], path.getState(i)[1]]) for i in range(path.getStateCount())]
+        states = [(path.getState(i)[0], path.getState(i)[1]) for i in range(path.getStateCount())]
         for a, b in itertools.pairwise(states):
-            steps = max(2, math.ceil(np.linalg.norm(b - a) / 0.001))
-            assert all(python_free(a + t * (b - a)) for t in np.linspace(0.0, 1.0, steps)), kind
+            start[0], start[1], end[0], end[1] = *a, *b
+            assert reference.isValid(start) and reference.checkMotion(start, end), kind
 
 
 def test_the_installed_objects_are_ompls_classes():

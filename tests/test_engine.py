@@ -260,6 +260,31 @@ def test_auto_plans_every_checker_on_the_compiled_engine():
         assert (planner.stats.engine, planner.stats.checks) == ("compiled", checks)
 
 
+def test_a_solve_handed_over_to_the_compiled_engine_makes_the_python_engines_trees(monkeypatch):
+    """engine=auto while the compiled engine loads: the solve begins on Python and the compiled
+    engine takes over once it is loaded (here: at the fourth time the planner asks), going on with
+    the same trees, random numbers and counts as a whole solve on either engine."""
+    from ompl_balance.engine import loading
+
+    make = get_problem("bug_trap").setup
+    python = solve(make, "python", params={"range": "0.05"})
+    ss = make()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.params().setParams({"engine": "auto", "seed": "3", "range": "0.05"})
+    ss.setPlanner(planner)
+    ss.setup()
+    planner.wait_for_engine()
+    asked = []
+    ready = loading.LOADER.ready
+    monkeypatch.setattr(loading.LOADER, "ready", lambda key: asked.append(key) or (len(asked) > 3 and ready(key)))
+    assert ss.solve(20.0)
+    assert planner.stats.engine == "python, then compiled" and planner.stats.iterations > 3 * 32
+    stats = {key: value for key, value in planner.stats.as_dict().items() if key not in IGNORED}
+    assert stats == python[0][1]
+    for tree, expected in zip((planner._start_tree, planner._goal_tree), python[0][2]):
+        np.testing.assert_array_equal(tree.states, expected)
+
+
 def robot_setup(motion, scene="arm3", problem_index=0):
     """A robot problem with the package's checker: the 3-joint test arm among four obstacles (a
     start and goal on either side of the wall) or a MotionBenchMaker Panda problem."""
@@ -528,9 +553,8 @@ def test_the_compiled_engine_polls_the_condition_every_few_milliseconds_and_stop
 
 @pytest.mark.parametrize("checker", ["kernel", "python callable"])
 def test_ctrl_c_interrupts_a_compiled_solve(checker):
-    """Both with kernels that never call Python (SIGINT's own handler stays: KeyboardInterrupt
-    between slices) and with a Python callable (KeyboardInterrupt inside its call, kept and
-    raised once the compiled code has returned)."""
+    """Both with kernels that never call Python (SIGINT's own handler stays) and with every check
+    an exit to Python (SIGINT only sets a flag while a slice runs)."""
     script = textwrap.dedent(
         f"""
         import signal, sys
@@ -624,9 +648,9 @@ def test_ctrl_c_between_slices_goes_to_the_process_own_handler_and_an_ignored_on
 
 
 def test_check_views_say_whether_their_kernels_call_python():
-    """Only a solve whose kernels call Python through numba's objmode takes SIGINT over (see above):
-    a box world's kernels never call Python; a Python callable is called through a C callback,
-    inside which Python raises KeyboardInterrupt as anywhere else (the engine reports it)."""
+    """Only a solve whose kernels may call Python takes SIGINT over (see above): a box world's
+    kernels never do; a Python callable is called from its view's kernels (through a C callback,
+    where a KeyboardInterrupt raised on the callback's first line could not be caught)."""
     from ompl_balance.engine.views import checks_for
 
     kernels, callable_world = impossible_setup(kernels=True), impossible_setup()
@@ -639,7 +663,7 @@ def test_check_views_say_whether_their_kernels_call_python():
     assert box_checks.path == "kernel" and box_checks.exits is False
     si = callable_world.getSpaceInformation()
     callable_checks = checks_for(si, layout)
-    assert callable_checks.path == "python" and callable_checks.exits is False
+    assert callable_checks.path == "python" and callable_checks.exits is True
 
 
 @pytest.mark.parametrize("motion", ["certified", "discrete"])

@@ -27,3 +27,28 @@ def entry_point(kernel: Any, arguments: tuple[Any, ...]) -> Callable[..., Any]:
         kernel.compile(signature)
     compiled: Any = kernel.overloads[signature]
     return compiled.entry_point
+
+
+def load_cached(kernel: Any, arguments: tuple[Any, ...]) -> bool:
+    """Load numba ``kernel``'s machine code for the types of ``arguments`` from numba's disk cache,
+    if it is there, as numba's dispatcher does before it compiles (``Dispatcher.compile``);
+    whether it was. Nothing is compiled: a caller that finds the cache empty can compile elsewhere
+    (another process) rather than hold this interpreter."""
+    from numba.core.compiler_lock import global_compiler_lock
+
+    signature = tuple(numba.typeof(a) for a in arguments)
+    with global_compiler_lock:
+        if signature in kernel.overloads:
+            return True
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
+                loaded = kernel._cache.load_overload(signature, kernel.targetctx)  # (numba's disk cache)
+        except Exception:
+            return False
+        if loaded is None:
+            return False
+        if not loaded.objectmode:
+            kernel.targetctx.insert_user_function(loaded.entry_point, loaded.fndesc, [loaded.library])
+        kernel.add_overload(loaded)
+    return True

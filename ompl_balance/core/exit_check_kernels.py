@@ -21,7 +21,7 @@ def _ask(view: ExitChecks, kind: int, count: int) -> int:  # pragma: no cover (c
     """One exit to the view's target about ``view.rows[:count]`` (counted); -1, with the view's
     RAISED flag set, when it raised."""
     view.counts[Count.EXITS] += 1
-    answer = call_exit(view.address, view.target, kind, count)
+    answer = call_exit(view.address, view.handle, kind, count)
     if answer < 0:
         view.counts[Count.RAISED] = 1
     return answer

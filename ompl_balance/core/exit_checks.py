@@ -40,8 +40,9 @@ class Query(enum.IntEnum):
 
 @kernels_in("ompl_balance.core.exit_check_kernels")
 class ExitChecks(NamedTuple):
-    """Checks by the Python object registered under handle ``target``, through the exit at
-    ``address`` (see the module docstring).
+    """Checks by the Python object registered under ``handle``, through the exit at ``address`` (see
+    the module docstring). (A view with a ``handle`` calls Python: while the engine runs it,
+    SIGINT only sets a flag, acted on between slices: ``engine.driver.interrupts_between_slices``.)
 
     ``rows`` (capacity, dim) holds the states a query is about, written by compiled code and
     read by the target; ``queue`` (capacity, 2) and ``order`` (capacity,) are the bisection's
@@ -49,7 +50,7 @@ class ExitChecks(NamedTuple):
     """
 
     address: int
-    target: int
+    handle: int
     layout: SpaceLayout
     rows: np.ndarray
     queue: np.ndarray

@@ -95,6 +95,12 @@ class ArrayPoints:
         self._next += 1
         return point
 
+    def block(self) -> tuple[np.ndarray, int]:
+        """The current block of uniform samples, ``(SAMPLE_BLOCK, dim)`` (``(0, dim)`` before the
+        first), and the row the next sample is taken from: where a compiled loop taking over a
+        solve goes on drawing."""
+        return self._block, self._next
+
     def distance(self, a: np.ndarray, b: np.ndarray) -> float:
         """OMPL's distance (the squares of a real-vector space summed over the coordinates in
         order, as the tree scans and the compiled engine sum them, to the last bit)."""

@@ -26,6 +26,7 @@ from ompl import base as ob
 from ompl import util as ou
 
 from ..core.checks import kernel_modules
+from ..core.compiled_calls import load_cached
 from ..core.layout import SpaceLayout
 from ..core.spaces import ArrayPoints
 from ..core.trees import Tree
@@ -51,22 +52,25 @@ def room_per_iteration(layout: SpaceLayout, extent: float, step: float, intermed
 
 
 def _warm(view: Any, layout: SpaceLayout) -> None:
-    """Make the engine for ``view`` and ``layout`` ready in this process: compiled into numba's
-    cache by another process (:mod:`ompl_balance.engine.compile_worker`; a compilation takes tens
-    of seconds, mostly in Python, and would hold this interpreter), then loaded from it here."""
-    try:
-        with _compile_lock():  # one compilation at a time on the machine: the next one finds it cached
-            subprocess.run(
-                [sys.executable, "-m", "ompl_balance.engine.compile_worker"],
-                input=pickle.dumps((view, layout)),
-                capture_output=True,
-                check=True,
-            )
-    except (OSError, subprocess.SubprocessError, pickle.PicklingError):
-        pass  # compiled here instead
+    """Make the engine for ``view`` and ``layout`` ready in this process: loaded from numba's cache,
+    or, when it is not there, compiled into it by another process first
+    (:mod:`ompl_balance.engine.compile_worker`; a compilation takes tens of seconds, mostly in
+    Python, and would hold this interpreter), then loaded."""
     modules = [importlib.import_module(module) for module in kernel_modules(view)]
-    from .driver import warm_up
+    from . import loop
+    from .driver import warm_up, warm_up_arguments
 
+    if not load_cached(loop.run, warm_up_arguments(view, layout)):
+        try:
+            with _compile_lock():  # one compilation at a time on the machine: the next one finds it cached
+                subprocess.run(
+                    [sys.executable, "-m", "ompl_balance.engine.compile_worker"],
+                    input=pickle.dumps((view, layout)),
+                    capture_output=True,
+                    check=True,
+                )
+        except (OSError, subprocess.SubprocessError, pickle.PicklingError):
+            pass  # compiled here instead
     warm_up(view, layout)
     for module in modules:  # the exits to Python, run once (see their warm_exits)
         warm_exits = getattr(module, "warm_exits", None)

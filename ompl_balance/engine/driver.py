@@ -23,7 +23,7 @@ from ompl import base as ob
 from ..core.checks import Count
 from ..core.compiled_calls import entry_point
 from ..core.layout import SpaceLayout
-from ..core.spaces import SAMPLE_BLOCK, Points
+from ..core.spaces import SAMPLE_BLOCK, ArrayPoints, Points
 from ..core.trees import ArrayTree
 from ..policies import SwapCause
 from . import loop
@@ -257,7 +257,16 @@ def run(
     layout, ints, reals = arrays.layout, arrays.loop.ints, arrays.loop.reals
     state = solve.swap_state
     ints[Slot.GREW_START], ints[Slot.STEPS], ints[Slot.COLLIDED] = state.grew_start, state.steps, state.collided
-    ints[Slot.NEXT_SAMPLE] = SAMPLE_BLOCK  # a fresh block at the first sample, as the Python engine's
+    # the Python engine's block of samples where it began this solve (else a fresh block at the
+    # first sample, as the Python engine's), and its counts
+    points = solve.points
+    assert isinstance(points, ArrayPoints)
+    block, next_sample = points.block()
+    if len(block):
+        arrays.loop.block[:] = block
+    ints[Slot.NEXT_SAMPLE] = next_sample if len(block) else SAMPLE_BLOCK
+    ints[Slot.ITERATIONS] = solve.counts.iterations
+    ints[Slot.SWAPS : Slot.SWAPS + len(SwapCause)] = solve.counts.swaps
     ints[Slot.ROOM] = room
     reals[Real.TREE_GAP] = solve.tree_gap
     exits_before = int(checks.view.counts[Count.EXITS])
@@ -336,9 +345,9 @@ def _fill_record(solve: Solve, arrays: loop.Loop) -> None:
             record.steps.append(GrowStep(iteration, bool(a), kind == 2, targets[row].copy(), b, bool(c), Grow(d), e))
 
 
-def warm_up(view: object, layout: SpaceLayout) -> None:
-    """Compile :func:`ompl_balance.engine.loop.run` for ``view``'s kind of checks (or load it from
-    numba's cache): a call of no iterations with arrays of the types a solve passes."""
+def warm_up_arguments(view: object, layout: SpaceLayout) -> tuple[Any, ...]:
+    """Arguments of :func:`ompl_balance.engine.loop.run` of the types a solve with ``view`` passes
+    (a call of no iterations: ``slice_ns`` 0)."""
     settings = loop_settings(RRTConnectSettings(range=1.0), step_may_stall=False, record=False)
     tree = loop.Tree(
         np.zeros((1, layout.dim)),
@@ -350,5 +359,13 @@ def warm_up(view: object, layout: SpaceLayout) -> None:
         new_index(layout, 1),
     )
     arrays = SolveArrays(layout).loop
-    rng = np.random.default_rng(0)
-    loop.run(view, layout, settings, (tree, tree), arrays, bit_generator_address(rng), 0)
+    return view, layout, settings, (tree, tree), arrays, bit_generator_address(_WARM_UP_RNG), 0
+
+
+_WARM_UP_RNG = np.random.default_rng(0)
+
+
+def warm_up(view: object, layout: SpaceLayout) -> None:
+    """Compile :func:`ompl_balance.engine.loop.run` for ``view``'s kind of checks (or load it from
+    numba's cache), and run it once (no iterations)."""
+    loop.run(*warm_up_arguments(view, layout))

@@ -127,9 +127,19 @@ class Extender:
         return (Grow.REACHED if reach else Grow.ADVANCED), added
 
 
-def run(solve: Solve, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus.PlannerStatusType:
+#: Iterations between two asks of :func:`run`'s ``hand_over``.
+HAND_OVER_EVERY = 32
+
+
+def run(
+    solve: Solve, ptc: ob.PlannerTerminationCondition, hand_over: Callable[[], bool] | None = None
+) -> ob.PlannerStatus.PlannerStatusType | None:
     """The loop until the trees connect (``EXACT_SOLUTION``, ``solve.connection`` set), ``ptc``
-    says stop (``TIMEOUT``) or no goal state can be had (``INVALID_GOAL``)."""
+    says stop (``TIMEOUT``) or no goal state can be had (``INVALID_GOAL``); or ``None`` at the start
+    of an iteration where ``hand_over()`` (asked every :data:`HAND_OVER_EVERY` iterations) says
+    the compiled engine, loaded meanwhile, takes the rest of the solve: everything the loop keeps
+    is in ``solve`` and the points' block of samples, so the compiled engine goes on with the
+    same trees and random numbers (``tests/test_engine.py``)."""
     settings, points, counts = solve.settings, solve.points, solve.counts
     start_tree, goal_tree = solve.start_tree, solve.goal_tree
     choice, nearest, targets = loop_policies(solve)
@@ -146,6 +156,8 @@ def run(solve: Solve, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus.P
     )
     plain_nearest = settings.nearest_policy == "euclidean"
     while not ptc():
+        if hand_over is not None and counts.iterations % HAND_OVER_EVERY == 0 and hand_over():
+            return None
         if solve.wants_goal() and not solve.feed_goal(ptc):
             return ob.PlannerStatus.INVALID_GOAL
         counts.iterations += 1
