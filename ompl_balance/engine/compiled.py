@@ -26,7 +26,6 @@ from ompl import base as ob
 from ompl import util as ou
 
 from ..core.checks import kernel_modules
-from ..core.compiled_calls import load_cached
 from ..core.layout import SpaceLayout
 from ..core.spaces import ArrayPoints
 from ..core.trees import Tree
@@ -57,6 +56,7 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
     (:mod:`ompl_balance.engine.compile_worker`; a compilation takes tens of seconds, mostly in
     Python, and would hold this interpreter), then loaded."""
     modules = [importlib.import_module(module) for module in kernel_modules(view)]
+    from ..core.compiled_calls import load_cached  # (imports numba)
     from . import loop
     from .driver import warm_up, warm_up_arguments
 
