@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -18,8 +19,16 @@ def test_the_notice_speaks_when_numba_compiles_and_not_when_the_kernel_is_ready(
     def doubled(x):
         return 2 * x
 
+    @njit(cache=False)
+    def tripled(x):
+        return 3 * x
+
     with compile_notice("the test's kernel"):
+        assert tripled(2) == 6  # compiled here, in a moment: not worth a line
+    assert capsys.readouterr().err == ""
+    with compile_notice("the test's kernel", quiet=0.0):
         assert doubled(21) == 42  # compiled here
+        time.sleep(0.2)  # (the notice's timer runs in a thread)
     err = capsys.readouterr().err.splitlines()
     assert err[0] == "ompl-balance: compiling the test's kernel with numba, once after installing (a minute or so) ..."
     assert err[1].startswith("ompl-balance: the test's kernel compiled in ") and len(err) == 2

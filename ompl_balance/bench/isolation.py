@@ -35,6 +35,7 @@ from ompl import util as ou
 
 from .execution import KEEP_UNTIL_EXIT, WARM_UP_TIME, execute
 from .experiment import Experiment, RunTask
+from .first_compile import compile_in_parallel
 from .problems import PROBLEM_KINDS
 from .results import Record, failure_properties, failure_record, run_record
 
@@ -87,7 +88,9 @@ def _nothing() -> None:
 def start_forkserver(preload: list[str]) -> None:
     """Start the forkserver and wait until it can fork runs: it has imported ``preload``, and
     numba has compiled or loaded the kernels they warm (the first time after installing, the
-    forkserver says on standard error that it compiles; see ``preload_robots``)."""
+    forkserver says on standard error that it compiles; see ``preload_robots``), in parallel
+    processes the first time (:func:`~ompl_balance.bench.first_compile.compile_in_parallel`)."""
+    compile_in_parallel(preload)
     process = _context(preload).Process(target=_nothing, name="forkserver ready")
     process.start()
     process.join()

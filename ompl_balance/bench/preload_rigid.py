@@ -1,7 +1,7 @@
 """Imported by the forkserver of a sweep with rigid-body problems (see ``problems.PROBLEM_KINDS``).
 
-It compiles the rigid-body kernels and loads the compiled engine for them, with either motion
-validator (with a notice the first time after installing, when numba compiles rather than loads
+It compiles the rigid-body kernels and loads the compiled engine for them with certified motions,
+the default (with a notice the first time after installing, when numba compiles rather than loads
 from its cache), once: every run's process is forked from the forkserver and starts with them.
 """
 
@@ -13,18 +13,18 @@ with compile_notice("the rigid-body collision kernels"):
     warm_up()
 
 
-def _load_engines() -> None:
-    """The compiled engine for rigid bodies in SE(2) and SE(3), with either motion validator."""
+def _load_engine() -> None:
+    """The compiled engine for rigid bodies in SE(2) and SE(3) with certified motions (a run with
+    discrete motions loads its engine itself, untimed)."""
     from ..planners import BalancedRRTConnect
     from ..worlds.rigid import rigid_problem
 
     for name in ("se2_slot", "se3_slot"):
-        for motion in ("certified", "discrete"):
-            ss = rigid_problem(name).simple_setup(motion=motion)
-            planner = BalancedRRTConnect(ss.getSpaceInformation())
-            ss.setPlanner(planner)
-            ss.setup()
-            planner.wait_for_engine()
+        ss = rigid_problem(name).simple_setup(motion="certified")
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        ss.setPlanner(planner)
+        ss.setup()
+        planner.wait_for_engine()
 
 
-_load_engines()
+_load_engine()

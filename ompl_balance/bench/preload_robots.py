@@ -16,8 +16,9 @@ with compile_notice("the robot layer's collision kernels"):
 load_shipped_data()
 
 
-def _load_engines() -> None:
-    """The compiled engine for robots, with either motion validator."""
+def _load_engine() -> None:
+    """The compiled engine for robots with certified motions (the default; a run with discrete
+    motions loads its engine itself, untimed)."""
     from ..collision.checker import CollisionChecker
     from ..collision.robots import load_panda_vamp
     from ..planners import BalancedRRTConnect
@@ -25,12 +26,11 @@ def _load_engines() -> None:
 
     robot = load_panda_vamp()
     problem = load_mbm("table_pick", robot.joint_names)[0]
-    for motion in ("certified", "discrete"):
-        ss = problem.simple_setup(robot, CollisionChecker(robot, problem.environment), motion=motion)
-        planner = BalancedRRTConnect(ss.getSpaceInformation())
-        ss.setPlanner(planner)
-        ss.setup()
-        planner.wait_for_engine()
+    ss = problem.simple_setup(robot, CollisionChecker(robot, problem.environment), motion="certified")
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    ss.setPlanner(planner)
+    ss.setup()
+    planner.wait_for_engine()
 
 
-_load_engines()
+_load_engine()

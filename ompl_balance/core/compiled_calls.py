@@ -17,11 +17,16 @@ import numba
 from numba.core.errors import NumbaIRAssumptionWarning
 
 
+def signature_of(arguments: tuple[Any, ...]) -> tuple[Any, ...]:
+    """The numba types of ``arguments``: what numba compiles a function for."""
+    return tuple(numba.typeof(a) for a in arguments)
+
+
 def entry_point(kernel: Any, arguments: tuple[Any, ...]) -> Callable[..., Any]:
     """The compiled function of numba ``kernel`` for the types of ``arguments``, compiled (or
     loaded from numba's cache) now, without calling it. (numba's internal pedantic check of
     the views' inlined kernels, a warning meant for numba's developers, is not shown.)"""
-    signature = tuple(numba.typeof(a) for a in arguments)
+    signature = signature_of(arguments)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
         kernel.compile(signature)
@@ -36,7 +41,7 @@ def load_cached(kernel: Any, arguments: tuple[Any, ...]) -> bool:
     (another process) rather than hold this interpreter."""
     from numba.core.compiler_lock import global_compiler_lock
 
-    signature = tuple(numba.typeof(a) for a in arguments)
+    signature = signature_of(arguments)
     with global_compiler_lock:
         if signature in kernel.overloads:
             return True

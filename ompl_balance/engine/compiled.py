@@ -11,6 +11,7 @@ plans on the compiled engine never loads it.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import importlib
 import math
 import pickle
@@ -56,19 +57,24 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
     (:mod:`ompl_balance.engine.compile_worker`; a compilation takes tens of seconds, mostly in
     Python, and would hold this interpreter), then loaded."""
     modules = [importlib.import_module(module) for module in kernel_modules(view)]
-    from ..core.compiled_calls import load_cached  # (imports numba)
+    from ..core.compiled_calls import load_cached, signature_of  # (these import numba)
+    from ..core.kernel_cache import package_digest
     from . import loop
     from .driver import warm_up, warm_up_arguments
 
-    if not load_cached(loop.run, warm_up_arguments(view, layout)):
+    arguments = warm_up_arguments(view, layout)
+    if not load_cached(loop.run, arguments):
         try:
-            with _compile_lock():  # one compilation at a time on the machine: the next one finds it cached
-                subprocess.run(
-                    [sys.executable, "-m", "ompl_balance.engine.compile_worker"],
-                    input=pickle.dumps((view, layout)),
-                    capture_output=True,
-                    check=True,
-                )
+            # one compilation of this specialization at a time on the machine (the next finds it
+            # cached); other specializations compile alongside, on the other cores
+            with _compile_lock(f"{package_digest()} {signature_of(arguments)}"):
+                if not load_cached(loop.run, arguments):
+                    subprocess.run(
+                        [sys.executable, "-m", "ompl_balance.engine.compile_worker"],
+                        input=pickle.dumps((view, layout)),
+                        capture_output=True,
+                        check=True,
+                    )
         except (OSError, subprocess.SubprocessError, pickle.PicklingError):
             pass  # compiled here instead
     warm_up(view, layout)
@@ -87,14 +93,16 @@ def runs_compiled(checks: EngineChecks, engine: str) -> bool:
 
 
 @contextlib.contextmanager
-def _compile_lock() -> Iterator[None]:
-    """An exclusive lock shared by the processes of the machine (where the system has ``flock``)."""
+def _compile_lock(what: str) -> Iterator[None]:
+    """An exclusive lock on compiling ``what``, shared by the processes of the machine (where the
+    system has ``flock``)."""
     try:
         import fcntl
     except ImportError:
         yield
         return
-    with open(Path(tempfile.gettempdir()) / "ompl_balance-compile.lock", "a") as lock:
+    name = hashlib.sha256(what.encode()).hexdigest()[:16]
+    with open(Path(tempfile.gettempdir()) / f"ompl_balance-compile-{name}.lock", "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         try:
             yield
@@ -190,7 +198,10 @@ class CompiledEngine:
 
 
 def _describe(checks: EngineChecks) -> str:
-    """The kind of checks, in words, for the compiling message."""
-    view = checks.view
-    inner = getattr(view, "states", None)
-    return type(view).__name__ if inner is None else f"{type(view).__name__} of {type(inner).__name__}"
+    """What the engine checks with, in the user's terms: the validity checker's and the motion
+    validator's classes."""
+    checker, validator = checks.source[:2]
+    check = getattr(checker, "check", checker)  # what a counting checker counts
+    owner = getattr(check, "__self__", check)  # a bound method's object
+    name = getattr(owner, "__qualname__", None) or type(owner).__name__
+    return f"{name} and {type(validator).__name__}"

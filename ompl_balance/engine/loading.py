@@ -136,9 +136,7 @@ class EngineLoader:
         error when that takes more than :data:`EXIT_QUIET_WAIT`. A thread cut off at exit would
         leave numba's work undone (the next process compiles again) and OMPL objects alive while
         Python shuts down, which nanobind reports as leaks."""
-        message = (
-            "the planning engine is still compiling; waiting for it before exit (numba caches it for later processes)"
-        )
+        message = "waiting for the planning engine to finish loading before exit (numba keeps it for later processes)"
         _join_saying(list(self._threads.values()), EXIT_QUIET_WAIT, message)
 
     def _warm(self, key: Hashable, warm: Callable[[], None]) -> None:

@@ -1,0 +1,50 @@
+"""The first sweep after installing: numba compiles the forkserver's kernels in parallel processes.
+
+A sweep's forkserver imports its preload modules (:func:`~ompl_balance.bench.isolation.preload_modules`)
+one after another, and each compiles what its runs need the first time after installing
+(tens of seconds each, numba compiling mostly in Python on one core). :func:`compile_in_parallel`
+has them compiled first, each imported by a process of its own, as many at once as the machine
+has cores; the forkserver then loads everything from numba's cache. A module done so is noted
+(by the package's digest, so an update compiles again), and later sweeps skip the step.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+
+def _done_marker(module: str) -> Path:
+    """The file that says ``module``'s kernels were compiled for this copy of the package."""
+    from ..core.kernel_cache import PACKAGE, package_digest
+
+    cache = os.environ.get("NUMBA_CACHE_DIR", "")
+    key = hashlib.sha256(f"{PACKAGE} {cache} {package_digest()} {module}".encode()).hexdigest()[:16]
+    return Path(tempfile.gettempdir()) / f"ompl_balance-compiled-{key}"
+
+
+def compile_in_parallel(modules: list[str]) -> None:
+    """Import each of ``modules`` whose kernels may not be compiled yet in a process of its own,
+    up to the machine's core count at once, and wait for them (their compile notices go to
+    standard error). Nothing is done for fewer than two: the forkserver compiles one as fast.
+    A process that fails is left to the forkserver, which compiles and reports the same."""
+    pending = [module for module in modules if module != "__main__" and not _done_marker(module).exists()]
+    if len(pending) < 2:
+        return
+    environment = {**os.environ, "PYTHONSAFEPATH": "1"}  # the installed package (see isolation._context)
+    running: list[tuple[str, subprocess.Popen[bytes]]] = []
+    for module in pending:
+        if len(running) >= (os.cpu_count() or 1):
+            _finish(*running.pop(0))
+        running.append((module, subprocess.Popen([sys.executable, "-c", f"import {module}"], env=environment)))
+    for module, process in running:
+        _finish(module, process)
+
+
+def _finish(module: str, process: subprocess.Popen[bytes]) -> None:
+    if process.wait() == 0:
+        _done_marker(module).touch()
