@@ -7,7 +7,7 @@ own process, see :mod:`ompl_balance.bench.isolation`) and keeps everything in on
     OUT/results.jsonl       one record per finished run, appended as runs finish
     OUT/logs/*.log          one OMPL benchmark log per problem (logs.write_logs)
     OUT/benchmark.db        the logs converted by OMPL's own converter, with its views
-    OUT/summary.md, .csv    medians, 95 % intervals, ratios to the baseline planner
+    OUT/summary.md, .csv    success; medians of the solved runs, 95 % intervals, ratios to the baseline planner
     OUT/superseded/         what earlier definitions produced: their runs (results.jsonl), logs
 
 Running the same experiment into the folder again runs only what is missing; runs of a
