@@ -47,7 +47,7 @@ from .bench.compare import (
     compare_experiment,
     parse_planners,
 )
-from .bench.errors import ExperimentError, MissingExtraError
+from .bench.errors import ClusterError, ExperimentError, MissingExtraError
 from .bench.experiment import Experiment, PlannerSpec
 from .bench.experiment_file import load_experiment
 from .bench.problems import problem_by_name
@@ -439,7 +439,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _gamma(args, parser)
         if args.command == "show":
             return _show(args)
-    except (ExperimentError, MissingExtraError) as error:
+    except (ExperimentError, MissingExtraError, ClusterError) as error:
         print(f"ompl-balance {args.command}: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
