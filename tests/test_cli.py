@@ -3,6 +3,7 @@ and wrong folders end in one line saying what to do."""
 
 import json
 import sqlite3
+import subprocess
 import sys
 import time
 
@@ -27,6 +28,23 @@ def test_compare_prints_a_table_per_problem(capsys):
     assert all("| 2 | 100% |" in row for row in rows)
     assert out.startswith("experiment seed 1\n")  # the default seed: the same command makes the same runs
     assert "runs in a temporary folder, now deleted (-o OUT keeps" in out
+
+
+def test_compare_writes_only_its_tables_to_standard_output(tmp_path):
+    """OMPL's log lines from the runs' processes (the forkserver's setup logs ``Info:``) go to
+    standard error; a fresh process, so that its forkserver starts with this command."""
+    done = subprocess.run(
+        [sys.executable, "-m", "ompl_balance.cli", "compare", "--problems", "open", "--runs", "1", "--no-progress"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("experiment seed 1\n") and "### open" in done.stdout
+    assert not any(line.startswith(("Info:", "Debug:", "Warning:")) for line in done.stdout.splitlines()), done.stdout
+    assert "Info:    BalancedRRTConnect: range computed" in done.stderr
 
 
 def test_compare_runs_motionbenchmaker_panda_problems_by_default(capsys):
