@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 from ompl import geometric as og
+from ompl import util as ou
 
 from ompl_balance import (
     BalancedRRTConnect,
@@ -32,6 +33,7 @@ def main() -> None:
     args = parser.parse_args()
     if not args.time_limit > 0:
         parser.error(f"--time-limit must be a positive number of seconds, got {args.time_limit}")
+    ou.setLogLevel(ou.LOG_WARN)  # OMPL's Debug and Info lines would bury the results
     try:
         robot = load_example_robot_data_panda()
     except ImportError as error:  # the robots extra is not installed

@@ -3,9 +3,9 @@
 ``ompl-balance compare``
     stock ``og.RRTConnect`` against ``BalancedRRTConnect`` (balancing on and off), or
     the planners given with ``--planners``, on the built-in 2-D problems, problem 1 of
-    each MotionBenchMaker Panda scenario and two shipped rigid-body problems; prints per problem the success rate, median
-    time, validity checks and nodes, each with its 95 % interval and its ratio to stock
-    RRT-Connect. With ``-o OUT`` the runs are kept, and the same command resumes.
+    each MotionBenchMaker Panda scenario and two shipped rigid-body problems; prints per problem the success rate and
+    the median time, validity checks and nodes of the solved runs, each with its 95 % interval and its
+    ratio to stock RRT-Connect's solved runs. With ``-o OUT`` the runs are kept, and the same command resumes.
 ``ompl-balance bench EXPERIMENT.toml -o OUT/``
     runs an experiment file (docs/benchmark.md) into ``OUT/``: results, OMPL logs, the
     SQLite database and the summary; running it again resumes.
@@ -47,7 +47,7 @@ from .bench.compare import (
     compare_experiment,
     parse_planners,
 )
-from .bench.errors import ExperimentError, MissingExtraError
+from .bench.errors import ClusterError, ExperimentError, MissingExtraError
 from .bench.experiment import Experiment, PlannerSpec
 from .bench.experiment_file import load_experiment
 from .bench.problems import problem_by_name
@@ -439,7 +439,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _gamma(args, parser)
         if args.command == "show":
             return _show(args)
-    except (ExperimentError, MissingExtraError) as error:
+    except (ExperimentError, MissingExtraError, ClusterError) as error:
         print(f"ompl-balance {args.command}: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

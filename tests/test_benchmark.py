@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import shutil
 import sqlite3
 import subprocess
@@ -569,3 +570,50 @@ def test_pooling_by_scenario_makes_one_cell_per_scenario_and_planner():
     cells = summarize(pooled_by_scenario(records), baseline="A", order=["A", "B"])
     assert [(c.problem, c.planner, c.runs) for c in cells] == [("box", "A", 2), ("box", "B", 2)]
     assert cells[1].time.ratio == 0.5
+
+
+def summary_record(planner: str, solved: bool, time_s: float, checks: int, problem: str = "p") -> dict:
+    """A run's record as far as the summary reads it."""
+    return {
+        "problem": problem,
+        "planner": planner,
+        "error": "",
+        "properties": {
+            "time REAL": time_s,
+            "solved BOOLEAN": int(solved),
+            "validity checks INTEGER": checks,
+            "graph states INTEGER": checks // 10,
+        },
+    }
+
+
+def test_summary_medians_and_ratios_are_of_solved_runs_only():
+    from ompl_balance.bench.summary import format_markdown
+
+    records = [
+        summary_record("stock", True, 0.2, 400),
+        summary_record("stock", True, 0.4, 600),
+        summary_record("stock", False, 5.0, 90000),  # ran until the limit: not what a solution cost
+        summary_record("fails fast", False, 0.0001, 1),
+        summary_record("fails fast", False, 0.0001, 1),
+        summary_record("half", True, 0.1, 100),
+        summary_record("half", False, 5.0, 50000),
+    ]
+    cells = {c.planner: c for c in summarize(records, "stock", ["stock", "fails fast", "half"])}
+    stock = cells["stock"]
+    assert (stock.time.median, stock.checks.median, stock.checks.ratio) == (pytest.approx(0.3), 500, 1.0)
+    assert cells["half"].success == 0.5
+    assert cells["half"].time.ratio == pytest.approx(0.1 / 0.3)
+    assert cells["half"].checks.ratio == pytest.approx(100 / 500)
+    failed = cells["fails fast"]
+    assert failed.success == 0.0
+    assert all(math.isnan(value) for m in (failed.time, failed.checks, failed.nodes) for value in (m.median, m.ratio))
+    table = format_markdown(list(cells.values()), "stock")
+    assert table.splitlines()[0].startswith("Success over all runs; times, validity checks and nodes are medians")
+    assert "| fails fast | 2 | 0% | - | - | - | - | - | - |" in table.splitlines()
+
+
+def test_no_ratio_to_a_baseline_that_solved_no_run():
+    records = [summary_record("stock", False, 5.0, 9000), summary_record("other", True, 0.5, 300)]
+    other = summarize(records, "stock", ["stock", "other"])[1]
+    assert other.checks.median == 300 and math.isnan(other.checks.ratio) and math.isnan(other.time.ratio)

@@ -8,6 +8,7 @@ thread, no memory limit).
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 
@@ -15,9 +16,11 @@ import pytest
 from test_benchmark import deterministic
 
 from ompl_balance.bench.compare import bench
+from ompl_balance.bench.execution import FIRST_SOLUTION_TIME
 from ompl_balance.bench.experiment import Experiment, PlannerSpec, package_planner_classes, stock_planner_classes
 from ompl_balance.bench.isolation import run_isolated
 from ompl_balance.bench.problems import ProblemSpec
+from ompl_balance.bench.progress_sampler import BEST_COST_PROPERTIES, SAMPLE_PERIOD
 
 TIME_LIMIT = 0.2  # s: planners that run to their limit stay brief
 
@@ -83,6 +86,23 @@ def test_no_planner_is_recorded_crashed_unless_it_hangs_by_itself(every_planner)
     solved = {(r["problem"], r["planner"]) for r in records if r["properties"]["solved BOOLEAN"]}
     # the planners with a thread of their own that the harness used to hang now solve
     assert {("narrow_gap", "PRM"), ("narrow_gap", "PRMstar"), ("open", "PRM"), ("open", "PRMstar")} <= solved
+
+
+def test_planners_that_keep_improving_record_when_they_first_had_a_solution(every_planner):
+    """Their solve ends at the time limit; the first solution time is read once an iteration, so
+    it comes before the first progress sample (every 0.05 s) that shows a solution's cost."""
+    _, records = every_planner
+    improving = [r for r in records if r["improves_cost"] and r["properties"]["solved BOOLEAN"]]
+    assert {"RRTstar", "BITstar", "AORRTC", "BallRadiusRRTstar"} <= {r["planner"] for r in improving}
+    for record in improving:
+        first = record["properties"][FIRST_SOLUTION_TIME]
+        names, samples = record["progress"]["properties"], record["progress"]["samples"]
+        cost = next(names.index(name) for name in BEST_COST_PROPERTIES if name in names)
+        sampled = [float(s[names.index("time REAL")]) for s in samples if s[cost] and math.isfinite(float(s[cost]))]
+        assert 0 < first <= min(sampled, default=record["properties"]["time REAL"]), record["planner"]
+    open_rrtstar = next(r for r in improving if (r["problem"], r["planner"]) == ("open", "RRTstar"))
+    assert open_rrtstar["properties"][FIRST_SOLUTION_TIME] < SAMPLE_PERIOD  # a few iterations in open space
+    assert not any(FIRST_SOLUTION_TIME in r["properties"] for r in records if not r["improves_cost"])
 
 
 #: Single-threaded stock planners that end at their first solution (well within 10 s on the narrow gap).

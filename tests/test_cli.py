@@ -3,7 +3,9 @@ and wrong folders end in one line saying what to do."""
 
 import json
 import sqlite3
+import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -26,6 +28,23 @@ def test_compare_prints_a_table_per_problem(capsys):
     assert all("| 2 | 100% |" in row for row in rows)
     assert out.startswith("experiment seed 1\n")  # the default seed: the same command makes the same runs
     assert "runs in a temporary folder, now deleted (-o OUT keeps" in out
+
+
+def test_compare_writes_only_its_tables_to_standard_output(tmp_path):
+    """OMPL's log lines from the runs' processes (the forkserver's setup logs ``Info:``) go to
+    standard error; a fresh process, so that its forkserver starts with this command."""
+    done = subprocess.run(
+        [sys.executable, "-m", "ompl_balance.cli", "compare", "--problems", "open", "--runs", "1", "--no-progress"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("experiment seed 1\n") and "### open" in done.stdout
+    assert not any(line.startswith(("Info:", "Debug:", "Warning:")) for line in done.stdout.splitlines()), done.stdout
+    assert "Info:    BalancedRRTConnect: range computed" in done.stderr
 
 
 def test_compare_runs_motionbenchmaker_panda_problems_by_default(capsys):
@@ -110,6 +129,32 @@ def test_dask_without_dask_is_one_line_naming_the_install(monkeypatch, capsys):
         ["compare", "--problems", "open", "--runs", "1", "--dask", "local:1"],
         "pip install 'ompl-balance[distributed]'",
     )
+
+
+def test_more_jobs_than_cores_warns_once_that_timings_compete(monkeypatch, capsys):
+    monkeypatch.setattr("os.cpu_count", lambda: 2)
+    args = ["compare", "--problems", "open", "--planners", "RRTConnect", "--runs", "3", "--no-progress"]
+    assert main([*args, "--jobs", "3"]) == 0
+    warnings = [line for line in capsys.readouterr().err.splitlines() if line.startswith("warning: --jobs")]
+    assert warnings == [
+        "warning: --jobs 3 is more than this machine's 2 cores: the runs' timings then compete for cores and come "
+        "out longer than alone (validity checks stay exact); --jobs 2 or fewer times them fairly"
+    ]
+    assert main([*args, "--jobs", "2"]) == 0
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_a_dask_scheduler_that_does_not_answer_is_one_line_naming_it(capsys):
+    pytest.importorskip("dask.distributed")
+    from ompl_balance.bench.scheduling import DASK_CONNECT_TIMEOUT
+
+    began = time.perf_counter()
+    _one_line_error(
+        capsys,
+        ["compare", "--problems", "open", "--runs", "1", "--no-progress", "--dask", "tcp://127.0.0.1:1"],
+        "--dask tcp://127.0.0.1:1: no Dask scheduler answered within 5 s",
+    )
+    assert time.perf_counter() - began < DASK_CONNECT_TIMEOUT + 10
 
 
 def test_plot_without_matplotlib_is_one_line_naming_the_install(monkeypatch, capsys, tmp_path):

@@ -1,9 +1,11 @@
-"""The examples answer --help without running, and say in one line which extra they need."""
+"""The examples answer --help without running, say in one line which extra they need, and print their
+results without OMPL's log lines."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
+from importlib import metadata
 from pathlib import Path
 
 import pytest
@@ -68,3 +70,23 @@ def test_an_example_without_its_extra_says_which_in_one_line(script, missing, in
     assert done.returncode != 0
     assert install in done.stderr and "Traceback" not in done.stderr, done.stderr
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
+
+
+def test_panda_table_prints_its_results_without_ompls_log_lines():
+    try:
+        metadata.distribution("example-robot-data")
+    except metadata.PackageNotFoundError:
+        pytest.skip("example-robot-data is not installed (the robots extra)")
+    done = subprocess.run(
+        [sys.executable, str(EXAMPLES / "panda_table.py"), "--time-limit", "2"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert [line.split()[0] for line in lines] == ["RRTConnect", "BalancedRRTConnect"], done.stdout
+    assert not any(
+        ("Debug:" in line or "Info:" in line) for line in done.stdout.splitlines() + done.stderr.splitlines()
+    )

@@ -22,11 +22,12 @@ import numpy as np
 import pytest
 from fresh_process import run_with_seed
 from ompl import base as ob
+from ompl import control as oc
 from ompl import geometric as og
 from ompl import tools as ot
 from ompl import util as ou
 
-from ompl_balance import PRESETS, BalancedRRTConnect
+from ompl_balance import PRESETS, BalancedRRTConnect, BallRadiusRRTstar
 from ompl_balance.worlds.boxes import Problem, get_problem
 
 ou.setLogLevel(ou.LOG_WARN)
@@ -97,6 +98,29 @@ def test_a_second_argument_that_is_not_a_bool_is_a_type_error_naming_the_signatu
         BalancedRRTConnect(si, argument)
     with pytest.raises(TypeError, match="name must be a str"):
         BalancedRRTConnect(si, False, 3)
+
+
+def _control_setup() -> oc.SimpleSetup:
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    return oc.SimpleSetup(oc.RealVectorControlSpace(space, 2))
+
+
+@pytest.mark.parametrize("planner_class", [BalancedRRTConnect, *PRESETS.values(), BallRadiusRRTstar])
+def test_a_control_space_information_or_a_simple_setup_is_a_type_error_naming_what_is_accepted(planner_class):
+    control = _control_setup()
+    geometric = get_problem("open").setup()
+    for given, kind in (
+        (control.getSpaceInformation(), "control.SpaceInformation"),
+        (control, "control.SimpleSetup"),
+        (geometric, "geometric.SimpleSetup"),
+    ):
+        with pytest.raises(TypeError) as raised:
+            planner_class(given)
+        message = str(raised.value)
+        assert "\n" not in message and kind in message, message
+        assert "si must be a geometric ompl.base.SpaceInformation (ss.getSpaceInformation() of an" in message
+    planner_class(geometric.getSpaceInformation())  # what is accepted
 
 
 # -- the planner graph ---------------------------------------------------------------------

@@ -218,6 +218,12 @@ def test_bad_input_names_the_file_and_line(scene):
         [*SE3_LINES[:2], "volume.min.x = 0", *SE3_LINES[2:]],
         r"problem\.cfg:3: the volume bounds are incomplete",
     )
+    for time_limit in ("-5", "0", "nan"):  # the last line of SE3_LINES
+        _error(
+            folder,
+            replace(len(SE3_LINES) - 1, f"time_limit = {time_limit}"),
+            rf"problem\.cfg:{len(SE3_LINES)}: time_limit = '{time_limit}' is not a positive number of seconds",
+        )
     _error(folder, replace(0, "[problem"), r"problem\.cfg:1: malformed section header")
     _error(folder, [*SE3_LINES, "[problem]", "start.x = 1"], r"start\.x is given twice \(first on line 5\)")
     (folder / "flat.obj").write_text("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n")

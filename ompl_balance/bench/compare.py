@@ -7,7 +7,7 @@ own process, see :mod:`ompl_balance.bench.isolation`) and keeps everything in on
     OUT/results.jsonl       one record per finished run, appended as runs finish
     OUT/logs/*.log          one OMPL benchmark log per problem (logs.write_logs)
     OUT/benchmark.db        the logs converted by OMPL's own converter, with its views
-    OUT/summary.md, .csv    medians, 95 % intervals, ratios to the baseline planner
+    OUT/summary.md, .csv    success; medians of the solved runs, 95 % intervals, ratios to the baseline planner
     OUT/superseded/         what earlier definitions produced: their runs (results.jsonl), logs
 
 Running the same experiment into the folder again runs only what is missing; runs of a
@@ -18,6 +18,7 @@ experiment's records at the end of every sweep, interrupted or not.
 
 from __future__ import annotations
 
+import os
 import re
 import sys
 from collections.abc import Callable, Sequence
@@ -140,7 +141,8 @@ def bench(
 
     ``jobs`` runs at a time on this machine, or on the Dask cluster ``dask``. Runs the
     folder holds under another definition of their cell are superseded and run again;
-    ``notify`` receives the notice saying so. Returns the experiment's records (all of
+    ``notify`` receives the notice saying so, and a warning when ``jobs`` exceeds the
+    machine's cores (the runs' timings then compete for them). Returns the experiment's records (all of
     them, earlier sweeps' included). :class:`~ompl_balance.bench.errors.ExperimentError` when
     ``out`` cannot be this experiment's folder (see :func:`~ompl_balance.bench.resume.claim`).
 
@@ -153,6 +155,13 @@ def bench(
         notify(claimed.message(out))
     store = ResultStore(out / RESULTS_FILE)
     if dask is None and missing_tasks(experiment, store):
+        cores = os.cpu_count() or 1
+        if jobs > cores:
+            notify(
+                f"warning: --jobs {jobs} is more than this machine's {cores} core{'s' * (cores > 1)}: the runs' timings then compete "
+                f"for cores and come out longer than alone (validity checks stay exact); --jobs {cores} or fewer "
+                "times them fairly"
+            )
         prepare_local_runs(experiment)
     bar = tqdm(
         total=len(experiment.tasks()),

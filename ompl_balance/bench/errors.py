@@ -1,4 +1,5 @@
-"""The errors a benchmark reports to its user: an experiment that cannot run, an extra not installed."""
+"""The errors a benchmark reports to its user: an experiment that cannot run, an extra not installed, a
+cluster that does not answer."""
 
 from __future__ import annotations
 
@@ -20,3 +21,7 @@ class ExperimentError(ValueError):
 
 class MissingExtraError(ImportError):
     """An optional dependency is not installed; the message names the ``pip install`` that adds it."""
+
+
+class ClusterError(ConnectionError):
+    """A Dask cluster that could not be reached; the message names its address and what was tried."""

@@ -27,8 +27,12 @@ from ..core.counting import read_work
 from .experiment import RunTask
 from .planner_params import named_by_getters, planner_params
 from .planner_properties import graph_properties, stats_properties, typed
-from .progress_sampler import ProgressSampler, improves_cost, progress_properties
+from .progress_sampler import FirstSolutionWatch, ProgressSampler, improves_cost, progress_properties
 from .results import STATUS_INDEX, Record, failure_properties, run_record, status_name
+
+#: The run property of a planner that keeps improving its solution: seconds from the start of its
+#: solve to its first solution (see :class:`~ompl_balance.bench.progress_sampler.FirstSolutionWatch`).
+FIRST_SOLUTION_TIME = "first solution time REAL"
 
 #: The phases of a run, in order, as :func:`execute` reports them. ``"engine"``: a planner of the
 #: package makes its compiled engine ready (loaded, or compiled on a first use after installing),
@@ -165,8 +169,11 @@ def execute(task: RunTask, phase: Callable[[str, Record | None], None] = _no_pha
     Properties (OMPL log names and types): time, memory, status, solved, approximate
     solution, solution length and segments, simplification time, simplified solution
     length and segments, graph states and motions, validity checks, motion checks,
-    distance queries, and every numeric field of the planner's ``stats`` (iterations,
-    start/goal tree size, tree swaps, sampler checks, ... for this package's planners).
+    distance queries, every numeric field of the planner's ``stats`` (iterations,
+    start/goal tree size, tree swaps, sampler checks, ... for this package's planners) and,
+    for a planner that keeps improving its solution until the time limit (RRT*), the first
+    solution time (:data:`FIRST_SOLUTION_TIME`: its termination condition looks at its best
+    cost once an iteration, a Python call the solve's time includes).
     The planner's progress properties, sampled every 0.05 s during the solve, go to the
     record's ``progress``. A solve that raises is recorded with OMPL's ``CRASH`` status.
     """
@@ -195,7 +202,9 @@ def execute(task: RunTask, phase: Callable[[str, Record | None], None] = _no_pha
         params["seed"] = "run"  # each run's own seed (the run property "seed")
     improving = improves_cost(planner)
     memory = MemoryLimit(task.memory_limit)
-    sampler = ProgressSampler(progress_properties(planner), check=memory.check if task.memory_limit > 0 else None)
+    progress = progress_properties(planner)
+    sampler = ProgressSampler(progress, check=memory.check if task.memory_limit > 0 else None)
+    first_solution = FirstSolutionWatch.of(progress) if improving else None
     work_before = read_work(si)
     began = time.perf_counter()
     try:
@@ -204,6 +213,8 @@ def execute(task: RunTask, phase: Callable[[str, Record | None], None] = _no_pha
             warm_up(task)  # its own problem and planner: neither timed nor counted
             work_before, began = read_work(si), time.perf_counter()
         ptc = ob.timedPlannerTerminationCondition(task.time_limit)
+        if first_solution is not None:
+            ptc = ob.plannerOrTerminationCondition(ptc, first_solution.condition())
         phase("solve", None)
         with memory.watch(ptc), sampler:
             # The sampling and memory threads run already: their start and end are the
@@ -226,6 +237,8 @@ def execute(task: RunTask, phase: Callable[[str, Record | None], None] = _no_pha
         "solved BOOLEAN": int(ss.haveExactSolutionPath()),
         **_work_properties(work.states_checked, work.motions_checked, work.distance_queries),
     }
+    if first_solution is not None and first_solution.found_at is not None:
+        properties[FIRST_SOLUTION_TIME] = first_solution.found_at - began
     solved = ss.haveSolutionPath()
     if solved:
         path = ss.getSolutionPath()  # keep the owner while reading it

@@ -16,11 +16,13 @@
   the baseline planner (and pooled per scenario for MotionBenchMaker problems);
 * ``trees_<problem>.png`` for each built-in 2-D problem: the start tree and the goal
   tree of ``BalancedRRTConnect`` with balancing on and off, seeded alike and stopped
-  after the same number of iterations.
+  after the same number of iterations; one panel, saying so, where both made the same
+  trees (balancing never chose another tree than alternation).
 
 *Time to a solution* is the run's ``time`` for planners that stop at their first solution;
 for planners that keep improving it until the time limit, whose ``time`` is the limit, it
-is the time of the first progress sample (every 0.05 s) that has a solution's cost.
+is their ``first solution time`` (looked at once an iteration, see
+:class:`~ompl_balance.bench.progress_sampler.FirstSolutionWatch`).
 Curves differ by colour, marker and line style, so they stay apart where they overlap
 and in grey print.
 """
@@ -31,6 +33,7 @@ import json
 import math
 import textwrap
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from itertools import count
 from pathlib import Path
 from typing import Any
@@ -42,16 +45,15 @@ from ..core.planner import GOAL_TAG, START_TAG
 from ..planners import BalancedRRTConnect
 from ..worlds.boxes import PROBLEMS
 from .errors import ExperimentError, MissingExtraError
+from .execution import FIRST_SOLUTION_TIME
 from .experiment import Experiment
 from .problems import PROBLEM_KINDS
+from .progress_sampler import BEST_COST_PROPERTIES
 from .results import Record, ResultStore
 from .resume import experiment_records, supersede_files
 from .summary import format_csv, format_markdown, pooled_by_scenario, summarize
 
 MATPLOTLIB_MISSING = "plots need matplotlib: pip install 'ompl-balance[plot]'"
-
-#: Progress properties that carry the best cost so far (RRTstar: REAL, BITstar: DOUBLE).
-BEST_COST_PROPERTIES = ("best cost REAL", "best cost DOUBLE")
 
 #: How a run ended, in the order the outcome bars stack them, with their colours.
 OUTCOMES = (("solved", "tab:green"), ("not solved", "tab:orange"), ("crashed or killed", "tab:red"))
@@ -98,21 +100,12 @@ def _best_cost_column(record: Record) -> int | None:
 
 def time_to_solution(record: Record) -> float | None:
     """Seconds from the start of the solve to the run's (first) exact solution; ``None`` when
-    it has none. For a planner that keeps improving its solution, the time of the first
-    progress sample with a finite best cost (sampled every 0.05 s; the end of the solve when
-    none has one)."""
+    it has none. For a planner that keeps improving its solution, its ``first solution time``;
+    else (and for an improving planner that reports no best cost) the end of its solve."""
     if outcome(record) != "solved":
         return None
-    end = float(record["properties"]["time REAL"])
-    column = _best_cost_column(record)
-    if not record.get("improves_cost") or column is None:
-        return end
-    progress = record["progress"]
-    time_column = progress["properties"].index("time REAL")
-    for sample in progress["samples"]:
-        if sample[column] and math.isfinite(float(sample[column])):
-            return float(sample[time_column])
-    return end
+    properties = record["properties"]
+    return float(properties.get(FIRST_SOLUTION_TIME, properties["time REAL"]))
 
 
 def _log_axis(axis: Any, which: str, low: float, high: float) -> None:
@@ -140,15 +133,30 @@ def _outcome_counts(runs: Sequence[Record]) -> dict[str, int]:
     return {name: ended.count(name) for name, _ in OUTCOMES}
 
 
+def _save(figure: Any, path: Path) -> Path:
+    """Write ``figure`` to ``path`` (PNG, 120 dpi) and close it."""
+    figure.savefig(path, dpi=120)
+    _pyplot().close(figure)
+    return path
+
+
 def plot_problem(records: Sequence[Record], problem: str, labels: Sequence[str], time_limit: float, path: Path) -> Path:
+    """:func:`problem_figure` written to ``path``."""
+    return _save(problem_figure(records, problem, labels, time_limit), path)
+
+
+def problem_figure(records: Sequence[Record], problem: str, labels: Sequence[str], time_limit: float) -> Any:
     """How each planner's runs on ``problem`` ended, and the time to a solution and the validity
-    checks of its solved runs (box plots, every run a point)."""
+    checks of its solved runs (box plots, every run a point): a matplotlib figure."""
     plt = _pyplot()
     mine = [r for r in records if r["problem"] == problem]
     labels = [label for label in labels if any(r["planner"] == label for r in mine)]
     runs = {label: [r for r in mine if r["planner"] == label] for label in labels}
     solved = {label: [r for r in runs[label] if outcome(r) == "solved"] for label in labels}
-    figure, axes = plt.subplots(1, 3, figsize=(15, 2.2 + 0.4 * len(labels)), layout="constrained", squeeze=False)
+    # the planners' labels once, left of the first panel: repeated, long labels would squeeze the others
+    figure, axes = plt.subplots(
+        1, 3, figsize=(15, 2.2 + 0.4 * len(labels)), layout="constrained", sharey=True, squeeze=False
+    )
     bars, times, checks = axes[0]
     positions = np.arange(len(labels))
     left = np.zeros(len(labels))
@@ -159,8 +167,6 @@ def plot_problem(records: Sequence[Record], problem: str, labels: Sequence[str],
     for position, label in zip(positions, labels):
         rate = len(solved[label]) / len(runs[label])
         bars.text(left[position], position, f" {rate:.0%} solved", va="center", fontsize=8)
-    bars.set_yticks(positions, labels, fontsize=8)
-    bars.invert_yaxis()
     bars.set_xlim(0, 1.35 * max(left))
     bars.set_xlabel("runs")
     bars.set_title("how the runs ended", fontsize=9)
@@ -173,14 +179,14 @@ def plot_problem(records: Sequence[Record], problem: str, labels: Sequence[str],
             "validity checks of the whole solve",
         ),
     ):
-        _box_plot(axis, values, labels)
+        _box_plot(axis, values)
         axis.set_title(f"{title}, solved runs", fontsize=9)
+    bars.set_yticks(positions, labels, fontsize=8)
+    bars.set_ylim(len(labels) - 0.5, -0.5)  # the first planner on top
     counts = {len(r) for r in runs.values()}
     per_planner = f"{counts.pop()} runs per planner" if len(counts) == 1 else "runs per planner as on the bars"
     figure.suptitle(f"{problem}: {per_planner}, time limit {time_limit:g} s", fontsize=10)
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
-    return path
+    return figure
 
 
 def _horizontal() -> dict[str, Any]:
@@ -191,13 +197,20 @@ def _horizontal() -> dict[str, Any]:
     return {"orientation": "horizontal"} if (major, minor) >= (3, 10) else {"vert": False}
 
 
-def _box_plot(axis: Any, values: Sequence[Sequence[float | None]], labels: Sequence[str]) -> None:
-    """Horizontal box plots of ``values`` per label, each value a point; "none solved" where empty."""
-    positions = np.arange(len(labels))
+def _box_plot(axis: Any, values: Sequence[Sequence[float | None]]) -> None:
+    """Horizontal box plots of ``values`` per planner at rows 0, 1, ... (the labels are the shared
+    y axis's), each value a point; "none solved" where empty."""
+    positions = np.arange(len(values))
     present = [[v for v in cell if v is not None] for cell in values]
     filled = [i for i, cell in enumerate(present) if cell]
     if filled:
-        axis.boxplot([present[i] for i in filled], positions=positions[filled], showfliers=False, **_horizontal())
+        axis.boxplot(
+            [present[i] for i in filled],
+            positions=positions[filled],
+            showfliers=False,
+            manage_ticks=False,  # the rows' ticks are the planners' labels
+            **_horizontal(),
+        )
         jitter = np.random.default_rng(0)
         for i in filled:
             offsets = jitter.uniform(-0.15, 0.15, len(present[i]))
@@ -208,8 +221,7 @@ def _box_plot(axis: Any, values: Sequence[Sequence[float | None]], labels: Seque
     for i, cell in enumerate(present):
         if not cell:
             axis.text(0.02, i, "none solved", transform=axis.get_yaxis_transform(), va="center", fontsize=8)
-    axis.set_yticks(positions, labels, fontsize=8)
-    axis.set_ylim(len(labels) - 0.5, -0.5)
+    axis.tick_params(axis="x", labelsize=8)
 
 
 def _grid(count: int) -> tuple[int, int]:
@@ -272,9 +284,7 @@ def plot_success(records: Sequence[Record], experiment: Experiment, path: Path) 
         f"{experiment.name}: fraction of the runs with a solution by time t (time limit {experiment.time_limit:g} s)",
         fontsize=10,
     )
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
-    return path
+    return _save(figure, path)
 
 
 def _best_cost_series(record: Record) -> tuple[np.ndarray, np.ndarray] | None:
@@ -353,9 +363,7 @@ def plot_progress(records: Sequence[Record], experiment: Experiment, problem: st
     axis.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     axis.set_title(f"{problem}: median best cost while planning", fontsize=10)
     figure.supxlabel(textwrap.fill(PROGRESS_CAPTION, 140), fontsize=8)
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
-    return path
+    return _save(figure, path)
 
 
 def grow_trees(problem: str, balance: bool, iterations: int, seed: int = 1) -> tuple[ob.PlannerData, int]:
@@ -379,48 +387,98 @@ def grow_trees(problem: str, balance: bool, iterations: int, seed: int = 1) -> t
     return planner.plannerData(), planner.stats.iterations
 
 
+@dataclass(frozen=True)
+class TreePicture:
+    """The two trees of a planner graph as drawn: states' ``(x, y)``, their tags (start or goal
+    tree), the edges, and the iterations that grew them."""
+
+    points: np.ndarray  # (n, 2)
+    tags: np.ndarray  # (n,)
+    edges: tuple[tuple[int, int], ...]
+    iterations: int
+
+    @classmethod
+    def grown(cls, problem: str, balance: bool, iterations: int, seed: int) -> TreePicture:
+        """The trees of :func:`grow_trees`."""
+        data, done = grow_trees(problem, balance, iterations, seed)
+        vertices = [data.getVertex(i) for i in range(data.numVertices())]
+        return cls(
+            points=np.array([[v.getState()[0], v.getState()[1]] for v in vertices]).reshape(-1, 2),
+            tags=np.array([v.getTag() for v in vertices]),
+            edges=tuple((i, int(j)) for i in range(len(vertices)) for j in data.getEdges(i)),
+            iterations=done,
+        )
+
+    def same_as(self, other: TreePicture) -> bool:
+        """Whether ``other`` holds the same trees."""
+        return (
+            self.iterations == other.iterations
+            and self.edges == other.edges
+            and np.array_equal(self.tags, other.tags)
+            and np.array_equal(self.points, other.points)
+        )
+
+    def size(self, tag: int) -> int:
+        return int((self.tags == tag).sum())
+
+
 TREES_CAPTION = (
     "Both panels use the same seed. Balanced growth departs from alternating growth only once the tree "
-    "sizes differ by max_tree_size_ratio; until then the two draw the same samples, so on problems where "
-    "the trees stay alike (open space, or a solution within a few iterations) the panels can look the same."
+    "sizes differ by max_tree_size_ratio; until then the two draw the same samples into the same trees."
+)
+
+SAME_TREES_CAPTION = (
+    "Seeded alike, balanced and alternating growth made the same trees: balancing grows the smaller tree once the "
+    "tree sizes differ by max_tree_size_ratio, and here it never chose another tree than alternation would have "
+    "(the trees stay alike in size), so both drew the same samples. Problems where one tree is trapped show the "
+    "difference."
 )
 
 
+def tree_panels(problem: str, iterations: int, seed: int = 1) -> list[tuple[str, TreePicture]]:
+    """The panels of :func:`plot_trees`, each a title and trees: balanced growth and alternating
+    growth, or one panel when both made the same trees (the same picture twice would look like
+    a comparison)."""
+    balanced, alternating = (TreePicture.grown(problem, balance, iterations, seed) for balance in (True, False))
+    if balanced.same_as(alternating):
+        return [("balanced and alternating growth: the same trees", balanced)]
+    return [("balanced growth", balanced), ("alternating growth", alternating)]
+
+
 def plot_trees(problem: str, iterations: int, path: Path, seed: int = 1) -> Path:
-    """Start tree (blue) and goal tree (orange) of balanced vs alternating growth, side by side."""
+    """Start tree (blue) and goal tree (orange) of balanced vs alternating growth, side by side; one
+    panel, saying so, when both made the same trees (:func:`tree_panels`)."""
     plt = _pyplot()
-    figure, axes = plt.subplots(1, 2, figsize=(10, 6.2), layout="constrained")
+    panels = tree_panels(problem, iterations, seed)
+    same = len(panels) == 1
+    figure, axes = plt.subplots(
+        1, len(panels), figsize=(7, 7) if same else (10, 6.6), layout="constrained", squeeze=False
+    )
     query = PROBLEMS[problem]
-    for axis, balance in zip(axes, (True, False)):
-        data, done = grow_trees(problem, balance, iterations, seed)
+    for axis, (growth, trees) in zip(axes[0], panels):
         for x_min, y_min, x_max, y_max in query.boxes:
             axis.add_patch(plt.Rectangle((x_min, y_min), x_max - x_min, y_max - y_min, color="0.6"))
-        points = np.array(
-            [[data.getVertex(i).getState()[0], data.getVertex(i).getState()[1]] for i in range(data.numVertices())]
-        )
-        tags = np.array([data.getVertex(i).getTag() for i in range(data.numVertices())])
         for tag, colour, name in ((START_TAG, "tab:blue", "start tree"), (GOAL_TAG, "tab:orange", "goal tree")):
-            for i in np.flatnonzero(tags == tag):
-                for j in data.getEdges(int(i)):
-                    axis.plot(points[[i, j], 0], points[[i, j], 1], color=colour, linewidth=0.6)
-            axis.scatter(points[tags == tag, 0], points[tags == tag, 1], s=3, color=colour, label=name)
+            for i, j in trees.edges:
+                if trees.tags[i] == tag:
+                    axis.plot(trees.points[[i, j], 0], trees.points[[i, j], 1], color=colour, linewidth=0.6)
+            mine = trees.points[trees.tags == tag]
+            axis.scatter(mine[:, 0], mine[:, 1], s=3, color=colour, label=name)
         axis.plot(*query.start, marker="*", markersize=16, color="tab:green", markeredgecolor="black", label="start")
         axis.plot(*query.goal, marker="X", markersize=13, color="tab:red", markeredgecolor="black", label="goal")
         axis.set_xlim(0, 1)
         axis.set_ylim(0, 1)
         axis.set_aspect("equal")
-        ending = "solved after" if done < iterations else "stopped after"
+        ending = "solved after" if trees.iterations < iterations else "stopped after"
         axis.set_title(
-            f"{'balanced' if balance else 'alternating'} growth, {ending} {done} iteration{'s' * (done != 1)}\n"
-            f"start tree {(tags == START_TAG).sum()} states, goal tree {(tags == GOAL_TAG).sum()} states",
+            f"{growth}\n{ending} {trees.iterations} iteration{'s' * (trees.iterations != 1)}\n"
+            f"start tree {trees.size(START_TAG)} states, goal tree {trees.size(GOAL_TAG)} states",
             fontsize=10,
         )
         axis.legend(loc="upper center", bbox_to_anchor=(0.5, -0.06), ncols=4, fontsize=8, markerscale=0.8)
     figure.suptitle(f"{problem}: BalancedRRTConnect with balance_tree_sizes on / off, seed {seed}")
-    figure.supxlabel(textwrap.fill(TREES_CAPTION, 160), fontsize=8)
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
-    return path
+    figure.supxlabel(textwrap.fill(SAME_TREES_CAPTION if same else TREES_CAPTION, 110 if same else 170), fontsize=8)
+    return _save(figure, path)
 
 
 def _read_experiment(out: Path) -> Experiment:

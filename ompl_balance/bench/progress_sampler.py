@@ -17,6 +17,9 @@ Where the properties come from (:func:`progress_properties`):
   and ``PRM``. These methods are safe to call during ``solve`` from Python because the run's
   validity checker is a Python callable (the run counts checks), so the solving thread
   returns to Python, where the sampler can take its turn, at every check.
+
+A planner that keeps improving its solution solves until its time limit; when it first had a
+solution, :class:`FirstSolutionWatch` notes to the iteration from its best cost.
 """
 
 from __future__ import annotations
@@ -33,6 +36,9 @@ from ompl import geometric as og
 
 #: OMPL's ``Benchmark::Request::timeBetweenUpdates`` default (s).
 SAMPLE_PERIOD = 0.05
+
+#: Progress properties that carry the best cost so far (RRTstar: REAL, BITstar: DOUBLE).
+BEST_COST_PROPERTIES = ("best cost REAL", "best cost DOUBLE")
 
 ProgressProperties = dict[str, Callable[[], str]]
 
@@ -104,6 +110,36 @@ def improves_cost(planner: ob.Planner) -> bool:
         return bool(planner.getSpecs().optimizingPaths)
     except TypeError:
         return isinstance(planner, STOCK_IMPROVING)
+
+
+class FirstSolutionWatch:
+    """When a planner that keeps improving its solution first has one: the moment its best cost
+    (``best_cost``, a progress property's function) is first finite, looked at each time the
+    planner evaluates :meth:`condition` (joined to its termination condition: once an
+    iteration). Such a planner's solve ends at its time limit, and its progress samples, every
+    :data:`SAMPLE_PERIOD` seconds, would only bound the moment from above.
+
+    :meth:`condition` never says stop; ``found_at`` is the ``time.perf_counter()`` of that first
+    look (``None`` until then).
+    """
+
+    def __init__(self, best_cost: Callable[[], str]) -> None:
+        self._best_cost = best_cost
+        self.found_at: float | None = None
+
+    @classmethod
+    def of(cls, properties: ProgressProperties) -> FirstSolutionWatch | None:
+        """The watch of a planner with these progress properties; ``None`` when none is its best cost."""
+        name = next((name for name in BEST_COST_PROPERTIES if name in properties), None)
+        return None if name is None else cls(properties[name])
+
+    def condition(self) -> ob.PlannerTerminationCondition:
+        return ob.PlannerTerminationCondition(self._look)
+
+    def _look(self) -> bool:
+        if self.found_at is None and math.isfinite(float(_read(self._best_cost) or "inf")):
+            self.found_at = time.perf_counter()
+        return False
 
 
 class ProgressSampler:

@@ -14,7 +14,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from typing import Any
 
-from .errors import MissingExtraError
+from .errors import ClusterError, MissingExtraError
 from .experiment import Experiment, RunTask
 from .isolation import preload_modules, run_isolated, start_forkserver, stop_runs
 from .results import Record, ResultStore, failure_record
@@ -64,8 +64,16 @@ def require_dask() -> None:
         raise MissingExtraError(DASK_MISSING) from error
 
 
+#: Seconds a Dask scheduler at ``tcp://host:port`` has to answer before the sweep gives up.
+DASK_CONNECT_TIMEOUT = 5.0
+
+
 def dask_client(address: str) -> Any:
-    """A ``dask.distributed.Client`` for ``"tcp://host:port"``, or a loopback ``LocalCluster`` for ``"local:N"``."""
+    """A ``dask.distributed.Client`` for ``"tcp://host:port"``, or a loopback ``LocalCluster`` for ``"local:N"``.
+
+    :class:`~ompl_balance.bench.errors.ClusterError` when no scheduler at ``address`` answers
+    within :data:`DASK_CONNECT_TIMEOUT` seconds.
+    """
     require_dask()
     import dask
     from dask.distributed import Client, LocalCluster
@@ -77,7 +85,14 @@ def dask_client(address: str) -> Any:
                 n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
             )
         return Client(cluster)
-    return Client(address)
+    try:
+        return Client(address, timeout=DASK_CONNECT_TIMEOUT)
+    except OSError as error:
+        raise ClusterError(
+            f"--dask {address}: no Dask scheduler answered within {DASK_CONNECT_TIMEOUT:g} s (a dask.distributed "
+            f"Client tried to connect); start one there with 'dask scheduler' and its workers with "
+            f"'dask worker {address}', or run on this machine with --dask local:N or --jobs N"
+        ) from error
 
 
 def _distributed(tasks: list[RunTask], preload: list[str], address: str) -> Iterator[Record]:

@@ -1,11 +1,12 @@
 """Summaries of sweep results: medians with bootstrap 95 % intervals, and ratios to a baseline.
 
-Per (problem, planner) cell: success rate, median time and median validity checks over
-all runs that report them (an unsolved run counts with the time and work it spent
-until its limit; a crashed run has no work count). Ratios are medians of the cell over
-medians of the baseline planner's cell on the same problem; their intervals come from
-resampling both cells independently (percentile bootstrap, fixed seed so a table is
-reproducible from its results).
+Per (problem, planner) cell: the success rate over all its runs, and the median time,
+validity checks and nodes of its solved runs only: a run that failed ran until its limit
+(or crashed), so its time and work say how long the limit was, not what a solution cost,
+and counting them would make a planner that fails quickly look cheap. Ratios are medians of
+the cell's solved runs over medians of the baseline planner's solved runs on the same
+problem, none where either solved no run; their intervals come from resampling both cells
+independently (percentile bootstrap, fixed seed so a table is reproducible from its results).
 """
 
 from __future__ import annotations
@@ -77,9 +78,14 @@ class CellSummary:
     runs: int
     crashed: int  # CRASH, or killed at the hard limit
     success: float  # fraction of runs with an exact solution
-    time: Measure  # s
-    checks: Measure  # validity checks
-    nodes: Measure  # states in the planner's graph (both trees for RRT-Connect)
+    time: Measure  # s, of the solved runs
+    checks: Measure  # validity checks of the solved runs
+    nodes: Measure  # states in the planner's graph (both trees for RRT-Connect), of the solved runs
+
+
+def _solved(records: Iterable[Record]) -> list[Record]:
+    """The runs that ended with an exact solution."""
+    return [r for r in records if r["properties"].get("solved BOOLEAN")]
 
 
 def _values(records: Iterable[Record], name: str) -> list[float]:
@@ -98,27 +104,22 @@ def summarize(records: Iterable[Record], baseline: str, order: Sequence[str] = (
     summaries = []
     for problem, planner in keys:
         runs = cells[problem, planner]
-        base = cells.get((problem, baseline), []) if planner != baseline else []
+        solved = _solved(runs)
+        base = _solved(cells.get((problem, baseline), [])) if planner != baseline else []
+        measures = {
+            name: measure(_values(solved, name), _values(base, name), rng, planner == baseline)
+            for name in ("time REAL", "validity checks INTEGER", "graph states INTEGER")
+        }
         summaries.append(
             CellSummary(
                 problem=problem,
                 planner=planner,
                 runs=len(runs),
                 crashed=sum(bool(r["error"]) for r in runs),
-                success=sum(r["properties"].get("solved BOOLEAN", 0) for r in runs) / len(runs),
-                time=measure(_values(runs, "time REAL"), _values(base, "time REAL"), rng, planner == baseline),
-                checks=measure(
-                    _values(runs, "validity checks INTEGER"),
-                    _values(base, "validity checks INTEGER"),
-                    rng,
-                    planner == baseline,
-                ),
-                nodes=measure(
-                    _values(runs, "graph states INTEGER"),
-                    _values(base, "graph states INTEGER"),
-                    rng,
-                    planner == baseline,
-                ),
+                success=len(solved) / len(runs),
+                time=measures["time REAL"],
+                checks=measures["validity checks INTEGER"],
+                nodes=measures["graph states INTEGER"],
             )
         )
     return summaries
@@ -138,9 +139,17 @@ def _with_interval(value: float, interval: Interval, digits: int) -> str:
     return f"{value:.{digits}f} [{interval[0]:.{digits}f}, {interval[1]:.{digits}f}]"
 
 
+def legend(baseline: str) -> str:
+    """What the summary's medians and ratios are taken over, in one line."""
+    return (
+        "Success over all runs; times, validity checks and nodes are medians [95 % intervals] of the solved "
+        f"runs only, ratios are to {baseline}'s solved runs; - where a planner or {baseline} solved no run."
+    )
+
+
 def format_markdown(summaries: Sequence[CellSummary], baseline: str) -> str:
-    """A markdown table per problem: success, medians of time, validity checks and nodes, and their
-    ratios to ``baseline``, each with its 95 % interval."""
+    """The :func:`legend`, then a markdown table per problem: success, medians of time, validity checks
+    and nodes of the solved runs, and their ratios to ``baseline``, each with its 95 % interval."""
     header = (
         f"| planner | runs | success | median time (ms) | time ratio to {baseline} | median validity checks "
         f"| checks ratio to {baseline} | median nodes | nodes ratio to {baseline} |\n|---|---|---|---|---|---|---|---|---|"
@@ -158,11 +167,12 @@ def format_markdown(summaries: Sequence[CellSummary], baseline: str) -> str:
                 f"| {_with_interval(s.nodes.median, s.nodes.interval, 0)} | {_with_interval(s.nodes.ratio, s.nodes.ratio_interval, 2)} |"
             )
         blocks.append(f"### {problem}\n\n{header}\n" + "\n".join(rows))
-    return "\n\n".join(blocks)
+    return "\n\n".join([legend(baseline), *blocks])
 
 
 def format_csv(summaries: Sequence[CellSummary]) -> str:
-    """The summaries as CSV, one row per cell, intervals as ``_low``/``_high`` columns."""
+    """The summaries as CSV, one row per cell, intervals as ``_low``/``_high`` columns (medians and
+    ratios of the solved runs, nan where there are none)."""
     columns = ["problem", "planner", "runs", "crashed", "success"]
     for name in ("time", "checks", "nodes"):
         columns += [

@@ -33,6 +33,7 @@ package ships none. Point the loader at your copy of OMPL.app's ``resources`` fo
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -105,15 +106,23 @@ class _Config:
         return self.entries[key]
 
     def number(self, key: str, why: str = "") -> float:
+        """The value of ``key``, a finite number."""
+        return self._accepted(key, why, math.isfinite, "a finite number")
+
+    def seconds(self, key: str) -> float:
+        """The value of ``key``, a positive number of seconds."""
+        return self._accepted(key, "", lambda value: 0 < value < math.inf, "a positive number of seconds")
+
+    def _accepted(self, key: str, why: str, accept: Callable[[float], bool], accepted: str) -> float:
+        """The value of ``key`` as a number that ``accept`` takes; ``ValueError`` naming the file,
+        line, key, value and what is ``accepted`` otherwise."""
         entry = self.text(key, why)
         try:
             value = float(entry.value)
         except ValueError:
             value = math.nan
-        if not math.isfinite(value):
-            raise ValueError(
-                f"{self.path}:{entry.line}: {key.partition('.')[2]} = {entry.value!r} is not a finite number"
-            )
+        if not accept(value):
+            raise ValueError(f"{self.path}:{entry.line}: {key.partition('.')[2]} = {entry.value!r} is not {accepted}")
         return value
 
     def at(self, key: str) -> str:
@@ -135,7 +144,8 @@ def load_omplapp(cfg_path: str | Path, validate: bool = True) -> RigidBodyProble
     """The geometric problem of an OMPL.app ``.cfg`` file (see the module docstring).
 
     ``ValueError`` naming the file (and line) for: a missing or unreadable file, a malformed
-    line, a missing or non-numeric entry, a missing or unreadable mesh, a mesh without
+    line, a missing or non-numeric entry, a ``time_limit`` that is not a positive number of seconds,
+    a missing or unreadable mesh, a mesh without
     triangles or only degenerate ones, inconsistent bounds, control-based problems
     (``control = ...``) or other state spaces (``statespace = dubins``, ...), which the loader
     does not plan for, and (``validate``, the default) a start or goal in collision. With
@@ -192,7 +202,7 @@ def load_omplapp(cfg_path: str | Path, validate: bool = True) -> RigidBodyProble
         goal=goal,
         low=low,
         high=high,
-        time_limit=config.number("benchmark.time_limit") if config.has("benchmark.time_limit") else None,
+        time_limit=config.seconds("benchmark.time_limit") if config.has("benchmark.time_limit") else None,
         goal_threshold=config.number("problem.threshold") if config.has("problem.threshold") else 1e-6,
         objective=objective,
         objective_threshold=objective_threshold,
