@@ -30,7 +30,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 from ompl import base as ob
-from ompl import control as oc
 from ompl import util as ou
 
 from .core.counting import WorkCount
@@ -51,18 +50,6 @@ ValidStateSamplerAllocator = Callable[[Any], Any]
 
 #: Nodes one iteration may add beyond which a solve stays on the Python engine (a tiny ``range``).
 MAX_ROOM = 1 << 20
-
-
-def refuse_non_geometric(planner: type[TreePlanner], si: object) -> None:
-    """``TypeError`` in one line unless ``si`` is a geometric ``ob.SpaceInformation``, as the
-    package's planners plan geometric paths: a control ``SpaceInformation`` (or a
-    ``SimpleSetup``) given to their constructor is refused."""
-    if not isinstance(si, ob.SpaceInformation) or isinstance(si, oc.SpaceInformation):
-        planner._refuse_argument(
-            "si must be a geometric ompl.base.SpaceInformation (ss.getSpaceInformation() of an "
-            "ompl.geometric.SimpleSetup)",
-            type(si),  # a space information's repr is its settings, many lines
-        )
 
 
 @dataclass
@@ -166,7 +153,6 @@ class BalancedRRTConnect(TreePlanner):
             )
         if name is None and addIntermediateStates:
             name = f"{type(self).__name__}Intermediate"
-        refuse_non_geometric(type(self), si)
         super().__init__(si, name)
         self.settings.update({**self.POLICIES, "intermediate_states": bool(addIntermediateStates)})
         self._valid_state_sampler_allocator: ValidStateSamplerAllocator | None = type(self).VALID_STATE_SAMPLER

@@ -24,7 +24,6 @@ from .core.planner import RANGE_AS_EXTENT_FRACTION, PlannerSpecs, TreePlanner
 from .core.spaces import Points
 from .core.trees import NO_PARENT, Tree
 from .gamma import EstimateInterruptedError, beta_quantile_function, estimate_ball_radius_constant, rewire_radius
-from .planners import refuse_non_geometric
 
 #: Monte Carlo samples used to estimate the free measure when ``ball_radius_constant`` is ``auto``.
 AUTO_GAMMA_SAMPLES = 5000
@@ -279,7 +278,6 @@ class BallRadiusRRTstar(TreePlanner):
     SPECS = PlannerSpecs(optimizingPaths=True)
 
     def __init__(self, si: ob.SpaceInformation, name: str | None = None) -> None:
-        refuse_non_geometric(type(self), si)
         super().__init__(si, name)
         self._estimated_gamma: float | None = None
         self._tree: CostTree | None = None

@@ -8,6 +8,7 @@ import os
 import threading
 import time
 
+import numpy as np
 import pytest
 from fresh_process import run_with_seed
 from ompl import base as ob
@@ -252,6 +253,25 @@ def test_solve_rejects_time_limits_that_are_not_finite(bad):
     planner.setProblemDefinition(ss.getProblemDefinition())
     with pytest.raises(ValueError, match="finite number of seconds"):
         planner.solve(bad)
+
+
+@pytest.mark.parametrize("limit", [1e10, 1e300, np.float64(1e12)])
+def test_a_time_limit_beyond_ompls_clock_plans_until_solved(limit):
+    """OMPL's own timed condition overflows past ~7.4e9 s and stops at once; a limit that large
+    means "no limit" to a user, and the planner plans until it has a solution."""
+    ss = get_problem("bug_trap").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setProblemDefinition(ss.getProblemDefinition())
+    assert planner.solve(limit) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.stats.iterations > 0
+
+
+@pytest.mark.parametrize("limit", [np.float32(0.5), np.int64(1)])
+def test_numpy_numbers_are_time_limits(limit):
+    ss = get_problem("open").setup()
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setProblemDefinition(ss.getProblemDefinition())
+    assert planner.solve(limit) == ob.PlannerStatus.EXACT_SOLUTION
 
 
 def test_ompl_benchmark_runs_and_logs_our_planner(tmp_path):

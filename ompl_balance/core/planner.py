@@ -23,6 +23,7 @@ lists those limits and how the package works around them.
 from __future__ import annotations
 
 import math
+import numbers
 import time
 import types
 from collections.abc import Callable, Iterable, Sequence
@@ -32,6 +33,7 @@ from typing import Any, ClassVar, TypeAlias
 import numpy as np
 import numpy.random  # imported now: numpy loads it lazily, and a solve must not pay for it
 from ompl import base as ob
+from ompl import control as oc
 from ompl import geometric as og
 from ompl import util as ou
 
@@ -52,20 +54,30 @@ GOAL_TAG = 2
 Limit: TypeAlias = "ob.PlannerTerminationCondition | float | Callable[[], bool]"
 
 
+#: Seconds beyond which OMPL's timed termination condition overflows its clock (its deadline,
+#: in nanoseconds, passes 2**63 near 7.4e9 s after the clock's epoch).
+LONGEST_LIMIT = 7.0e9
+
+
 def termination_condition(limit: Limit) -> ob.PlannerTerminationCondition:
     """A ``PlannerTerminationCondition`` from what ``solve`` was given.
 
     C++ callers (``SimpleSetup``, ``Benchmark``) pass a condition; Python callers may
     pass a time limit in seconds or a callable that returns ``True`` when planning
     should stop. As OMPL's ``Planner::solve(double)``, a limit of zero or less stops at
-    once; a limit that is not a finite number is refused.
+    once; a limit that is not a finite number is refused; one beyond OMPL's clock (about 230
+    years, :data:`LONGEST_LIMIT`) never stops planning, where OMPL's own condition would
+    overflow and stop at once.
     """
     if isinstance(limit, ob.PlannerTerminationCondition):
         return limit
-    if isinstance(limit, (int, float)) and not isinstance(limit, bool):
-        if not math.isfinite(limit):
+    if isinstance(limit, numbers.Real) and not isinstance(limit, (bool, np.bool_)):
+        seconds = float(limit)
+        if not math.isfinite(seconds):
             raise ValueError(f"solve() time limit must be a finite number of seconds, got {limit!r}")
-        return ob.timedPlannerTerminationCondition(max(float(limit), 0.0))
+        if seconds > LONGEST_LIMIT:
+            return ob.plannerNonTerminatingCondition()
+        return ob.timedPlannerTerminationCondition(max(seconds, 0.0))
     if callable(limit):
         return ob.PlannerTerminationCondition(limit)
     raise TypeError(
@@ -162,6 +174,13 @@ class TreePlanner(ob.Planner):
     def __init__(self, si: ob.SpaceInformation, name: str | None = None) -> None:
         if name is not None and not isinstance(name, str):
             self._refuse_argument("name must be a str", name)
+        if not isinstance(si, ob.SpaceInformation) or isinstance(si, oc.SpaceInformation):
+            # the package's planners plan geometric paths: a control space information is refused
+            self._refuse_argument(
+                "si must be a geometric ompl.base.SpaceInformation (ss.getSpaceInformation() of an "
+                "ompl.geometric.SimpleSetup)",
+                type(si),  # a space information's repr is its settings, many lines
+            )
         super().__init__(si, name or type(self).__name__)
         # nanobind resolves the C++ side of the Python-only methods now (see _ForPythonCallers).
         ob.Planner.getPlannerData(self, ob.PlannerData(si))
