@@ -7,6 +7,9 @@ an OMPL user would write it:
     2-D: the start inside a square room whose only door faces away from the goal (~1 us checks);
 ``slalom``
     2-D: three staggered walls between the start and the goal (~1 us checks);
+``comb``
+    2-D: seven walls with narrow gaps at alternate ends (~1.5 us checks; solves of tens of ms,
+    where a solve's fixed costs weigh least);
 ``arm7``
     7-D: a planar arm of seven links among four discs, the start reaching right and the goal
     reaching left (forward kinematics and disc tests, ~15-20 us checks in Python).
@@ -32,7 +35,7 @@ checker and to stock with the plain callable, and the path the package's checks 
 (``engine``, ``checks``, calls out of compiled code per solve). ``--profile`` prints where a
 Balanced solve's time goes with the plain callable (cProfile).
 
-    python benchmarks/bench_checkers.py [--runs 30] [--worlds trap,slalom,arm7] [--profile]
+    python benchmarks/bench_checkers.py [--runs 30] [--worlds trap,slalom,comb,arm7] [--profile]
 """
 
 from __future__ import annotations
@@ -65,8 +68,17 @@ TRAP = (
     (0.54, 0.67, 0.70, 0.70),
 )
 SLALOM = ((0.20, 0.00, 0.25, 0.85), (0.45, 0.15, 0.50, 1.00), (0.70, 0.00, 0.75, 0.85))
+# seven walls, each with a gap of 0.04 at alternate ends: long solves, many checks
+COMB = tuple(
+    (x, 0.04, x + 0.02, 1.0) if index % 2 == 0 else (x, 0.0, x + 0.02, 0.96)
+    for index, x in enumerate((0.12, 0.24, 0.36, 0.48, 0.60, 0.72, 0.84))
+)
 #: name -> (boxes, start, goal)
-PLANAR = {"trap": (TRAP, (0.5, 0.4), (0.5, 0.1)), "slalom": (SLALOM, (0.05, 0.05), (0.95, 0.95))}
+PLANAR = {
+    "trap": (TRAP, (0.5, 0.4), (0.5, 0.1)),
+    "slalom": (SLALOM, (0.05, 0.05), (0.95, 0.95)),
+    "comb": (COMB, (0.05, 0.5), (0.95, 0.5)),
+}
 
 # -- 7-D world: a planar arm of seven links among discs -------------------------------------------
 
@@ -297,7 +309,7 @@ def profile(world: World) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=30, help="runs per planner and checker (default 30)")
-    parser.add_argument("--worlds", default="trap,slalom,arm7", help="comma-separated: trap, slalom, arm7")
+    parser.add_argument("--worlds", default="trap,slalom,comb,arm7", help="comma-separated: trap, slalom, comb, arm7")
     parser.add_argument("--checkers", default="callable,numba,vectorized", help="comma-separated")
     parser.add_argument("--profile", action="store_true", help="profile a Balanced solve with the callable")
     args = parser.parse_args()

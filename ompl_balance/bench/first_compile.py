@@ -30,8 +30,9 @@ def _done_marker(module: str) -> Path:
 def compile_in_parallel(modules: list[str]) -> None:
     """Import each of ``modules`` whose kernels may not be compiled yet in a process of its own,
     up to the machine's core count at once, and wait for them (their compile notices go to
-    standard error). Nothing is done for fewer than two: the forkserver compiles one as fast.
-    A process that fails is left to the forkserver, which compiles and reports the same."""
+    standard error, their standard output nowhere). Nothing is done for fewer than two: the
+    forkserver compiles one as fast. A process that fails is left to the forkserver, which
+    compiles and reports the same."""
     pending = [module for module in modules if module != "__main__" and not _done_marker(module).exists()]
     if len(pending) < 2:
         return
@@ -40,7 +41,9 @@ def compile_in_parallel(modules: list[str]) -> None:
     for module in pending:
         if len(running) >= (os.cpu_count() or 1):
             _finish(*running.pop(0))
-        running.append((module, subprocess.Popen([sys.executable, "-c", f"import {module}"], env=environment)))
+        # (standard output: OMPL's Info lines, which must not reach the tables on the caller's)
+        command = [sys.executable, "-c", f"import {module}"]
+        running.append((module, subprocess.Popen(command, env=environment, stdout=subprocess.DEVNULL)))
     for module, process in running:
         _finish(module, process)
 

@@ -1,0 +1,52 @@
+"""The first sweep after installing: the forkserver's modules compiled in parallel processes, once."""
+
+from __future__ import annotations
+
+import tempfile
+import time
+
+import pytest
+
+from ompl_balance.bench import first_compile
+
+# a module standing for a preload module: it notes when it was imported and takes a while,
+# as numba compiling would
+SLOW_MODULE = """
+import os, pathlib, time
+began = time.time()
+time.sleep(1.0)
+pathlib.Path(os.environ["IMPORTS"], __name__).write_text(f"{began} {time.time()}")
+print("Info: what OMPL prints on standard output")
+"""
+
+
+@pytest.fixture
+def slow_modules(tmp_path, monkeypatch):
+    modules = tmp_path / "modules"
+    modules.mkdir()
+    for name in ("slow_one", "slow_two"):
+        (modules / f"{name}.py").write_text(SLOW_MODULE)
+    (tmp_path / "imports").mkdir()
+    monkeypatch.setenv("PYTHONPATH", str(modules))
+    monkeypatch.setenv("IMPORTS", str(tmp_path / "imports"))
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # where the done markers go
+    monkeypatch.setattr(first_compile.os, "cpu_count", lambda: 2)
+    return tmp_path / "imports"
+
+
+def test_modules_are_imported_at_once_in_processes_of_their_own_then_never_again(slow_modules, capfd):
+    began = time.time()
+    first_compile.compile_in_parallel(["__main__", "slow_one", "slow_two"])
+    spans = [tuple(map(float, (slow_modules / name).read_text().split())) for name in ("slow_one", "slow_two")]
+    assert max(start for start, _ in spans) < min(end for _, end in spans)  # they overlapped
+    assert all(began <= start for start, _ in spans)
+    assert "Info:" not in capfd.readouterr().out  # the tables' stream stays clean
+    for path in slow_modules.iterdir():
+        path.unlink()
+    first_compile.compile_in_parallel(["__main__", "slow_one", "slow_two"])
+    assert list(slow_modules.iterdir()) == []  # done once: not imported again
+
+
+def test_a_single_module_is_left_to_the_forkserver(slow_modules):
+    first_compile.compile_in_parallel(["__main__", "slow_one"])
+    assert list(slow_modules.iterdir()) == []
