@@ -18,10 +18,13 @@ from __future__ import annotations
 
 import argparse
 import base64
+import contextlib
 import io
 import itertools
 import json
+import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -70,7 +73,9 @@ class Browser:
         executable = executable or chromium()
         if executable is None:
             raise RuntimeError("Chromium is not installed (apt-get install chromium)")
-        self._profile = tempfile.TemporaryDirectory(prefix="ompl-balance-chromium-")
+        # (Chromium's helper processes may still write to the profile as it is removed: a
+        # leftover file there is no failure of the test)
+        self._profile = tempfile.TemporaryDirectory(prefix="ompl-balance-chromium-", ignore_cleanup_errors=True)
         self.process = subprocess.Popen(
             [
                 executable,
@@ -82,6 +87,7 @@ class Browser:
             ],
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
+            start_new_session=True,  # its own process group: closing ends its helpers too
         )
         port_file = Path(self._profile.name) / "DevToolsActivePort"
         deadline = time.monotonic() + 30
@@ -105,7 +111,7 @@ class Browser:
         self.close()
 
     def close(self) -> None:
-        """End Chromium (this object's process only) and remove its profile."""
+        """End Chromium (this object's process group only) and remove its profile."""
         socket = getattr(self, "_socket", None)
         if socket is not None:
             socket.close()
@@ -116,6 +122,8 @@ class Browser:
             except subprocess.TimeoutExpired:
                 self.process.kill()
                 self.process.wait()
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(self.process.pid, signal.SIGKILL)  # helpers left behind
         self._profile.cleanup()
 
     def call(self, method: str, **params: object) -> dict:
