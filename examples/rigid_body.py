@@ -30,7 +30,8 @@ def main() -> None:
     for planner in (og.RRTConnect, BalancedRRTConnect):
         checker = problem.checker()
         ss = problem.simple_setup(checker=checker)  # certified motions
-        ss.setPlanner(planner(ss.getSpaceInformation()))
+        made = planner(ss.getSpaceInformation())
+        ss.setPlanner(made)
         ss.setup()
         began = time.perf_counter()
         ss.solve(problem.time_limit or 10.0)
@@ -38,8 +39,10 @@ def main() -> None:
         work = read_work(ss.getSpaceInformation())
         solved = ss.haveExactSolutionPath()
         certified = solved and certify_path(checker, ss.getSolutionPath()).certified
+        stats = getattr(made, "stats", None)  # the package's planners: which engine solved
+        engine = "" if stats is None else f" ({stats.engine} engine)"
         print(
-            f"{planner.__name__:>20}: solved {solved}, {elapsed:.2f} s, {work.states_checked} states, "
+            f"{planner.__name__:>20}: solved {solved}, {elapsed:.2f} s{engine}, {work.states_checked} states, "
             f"{work.motions_checked} motions checked; path certified: {certified}"
         )
 
