@@ -550,28 +550,6 @@ def test_write_logs_leaves_blank_what_a_crashed_run_lacks(tiny_sweep, tmp_path):
     assert "; ; " in run_lines[1]  # blanks where the crashed run has no value
 
 
-def test_pooling_by_scenario_makes_one_cell_per_scenario_and_planner():
-    from ompl_balance.bench.summary import pooled_by_scenario, summarize
-
-    def record(problem, planner, time_s):
-        return {
-            "problem": problem,
-            "planner": planner,
-            "error": "",
-            "properties": {
-                "time REAL": time_s,
-                "solved BOOLEAN": 1,
-                "validity checks INTEGER": 10,
-                "graph states INTEGER": 5,
-            },
-        }
-
-    records = [record(f"box.{i:03d}", planner, t) for i in (1, 2) for planner, t in (("A", 1.0), ("B", 0.5))]
-    cells = summarize(pooled_by_scenario(records), baseline="A", order=["A", "B"])
-    assert [(c.problem, c.planner, c.runs) for c in cells] == [("box", "A", 2), ("box", "B", 2)]
-    assert cells[1].time.ratio == 0.5
-
-
 def summary_record(planner: str, solved: bool, time_s: float, checks: int, problem: str = "p") -> dict:
     """A run's record as far as the summary reads it."""
     return {
@@ -585,6 +563,19 @@ def summary_record(planner: str, solved: bool, time_s: float, checks: int, probl
             "graph states INTEGER": checks // 10,
         },
     }
+
+
+def test_pooling_by_scenario_makes_one_cell_per_scenario_and_planner():
+    from ompl_balance.bench.summary import pooled_by_scenario, summarize
+
+    records = [
+        summary_record(planner, True, t, 10, problem=f"box.{i:03d}")
+        for i in (1, 2)
+        for planner, t in (("A", 1.0), ("B", 0.5))
+    ]
+    cells = summarize(pooled_by_scenario(records), baseline="A", order=["A", "B"])
+    assert [(c.problem, c.planner, c.runs) for c in cells] == [("box", "A", 2), ("box", "B", 2)]
+    assert cells[1].time.ratio == 0.5
 
 
 def test_summary_medians_and_ratios_are_of_solved_runs_only():
