@@ -110,19 +110,40 @@ def test_a_numba_function_and_the_same_test_as_a_plain_callable_make_the_same_tr
         assert_same_run(runs[0], other)
 
 
-def test_the_compiled_engine_calls_python_once_per_motion_for_a_plain_callable():
-    """Every check of a plain callable is made in Python, a motion's states in one call: the calls
-    out of compiled code are the motions plus the goal tree's new states, and fewer than the
-    states; a numba function makes none."""
-    ss = square(plain=state_free)
-    planner = BalancedRRTConnect(ss.getSpaceInformation())
-    planner.setEngine("compiled")
-    planner.setSeed(2)
-    ss.setPlanner(planner)
-    assert ss.solve(10.0)
-    stats = planner.stats
-    assert (stats.engine, stats.checks) == ("compiled", "python")
-    assert stats.motions_checked <= stats.exits < stats.states_checked
+@pytest.mark.parametrize("kind", ["plain", "python", "vectorized"])
+def test_the_compiled_engine_calls_python_once_per_growth_of_a_tree(kind):
+    """Every check of a function written in Python is made in Python, all the states one growth
+    of a tree tests in one call (an extension step: a goal tree's new state and its motion; a
+    connect: all its steps): the calls out of compiled code are the growths the loop record
+    shows, and the work is that of the Python engine (one state at a time) on the same seed;
+    a numba function makes no call at all."""
+    from ompl_balance.engine.events import LoopRecord
+
+    def setup():
+        if kind == "plain":
+            return square(plain=state_free)
+        return square(*KINDS[kind])
+
+    runs = {}
+    for engine in ("compiled", "python"):
+        ss = setup()
+        planner = BalancedRRTConnect(ss.getSpaceInformation())
+        planner.setEngine(engine)
+        planner.setSeed(2)
+        planner.loop_record = LoopRecord()
+        ss.setPlanner(planner)
+        assert ss.solve(10.0)
+        runs[engine] = planner
+    stats, record = runs["compiled"].stats, runs["compiled"].loop_record
+    assert (stats.engine, stats.checks) == ("compiled", "python" if kind == "plain" else "kernel")
+    growths = sum(1 for step in record.steps if not (step.connect and step.node_given))
+    assert stats.exits == growths
+    assert stats.exits < stats.states_checked
+    python = runs["python"].stats
+    assert (stats.states_checked, stats.motions_checked) == (python.states_checked, python.motions_checked)
+    other = runs["python"].loop_record.steps
+    assert [step._replace(target=None) for step in record.steps] == [step._replace(target=None) for step in other]
+    assert all(np.array_equal(a.target, b.target) for a, b in zip(record.steps, other))
     ss = make("numba")()
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     planner.setEngine("compiled")
@@ -202,6 +223,71 @@ def test_motions_get_ompls_answers_and_test_as_many_states(kind):
         answers.append(answer)
     assert 0 < sum(answers) < len(answers)  # both kinds of answer were given
     assert validator.counters()["motions_checked"] == 300
+
+
+class RowsTarget:
+    """An exit's target testing rows with :func:`python_free`, as the package's function targets do."""
+
+    def __init__(self):
+        self.error, self.rows = None, np.empty((0, 2))
+
+    def answer(self, kind, count):
+        for index in range(count):
+            if not python_free(self.rows[index]):
+                return index
+        return count
+
+
+@pytest.mark.parametrize("rows", [3, 40, None])
+@pytest.mark.parametrize("outward", [True, False])
+def test_a_trees_steps_checked_together_are_checked_as_one_by_one(rows, outward):
+    """``steps_free`` of a batched exit view (all a connect's steps in one call to Python, in parts
+    when its rows are full: 3 and 40 rows, and the view's own): on 200 random chains of steps,
+    the steps taken, the states tested and the motions begun are those of OMPL's own
+    ``isValid`` and ``DiscreteMotionValidator`` called one step at a time as RRT-Connect grows a
+    tree (outward: the start tree; else the goal tree, the new state first)."""
+    from ompl_balance.core.checks import Count, load_kernels, steps_free
+    from ompl_balance.core.exit_checks import exit_checks
+    from ompl_balance.core.layout import layout_for
+
+    reference, calls = ompl_reference(state_free)
+    layout = layout_for(reference.getStateSpace())
+    target = RowsTarget()
+    view = exit_checks(target, layout, reference.getMaximumExtent(), np.zeros(len(Count), dtype=np.int64), True)
+    if rows is not None:
+        view = view._replace(rows=np.empty((rows, 2)), row_steps=np.empty(rows, dtype=np.int64))
+    target.rows = view.rows
+    load_kernels(view)
+
+    @numba.njit
+    def call(view, chain, steps, outward):  # (steps_free from compiled code, as the loop calls it)
+        return steps_free(view, chain, steps, outward)
+
+    rng = np.random.default_rng(11)
+    a, b = reference.allocState(), reference.allocState()
+    taken = []
+    for _ in range(200):
+        steps = int(rng.integers(1, 6))
+        chain = np.cumsum(np.vstack([rng.random(2), 0.15 * (rng.random((steps, 2)) - 0.5)]), axis=0).clip(0.0, 1.0)
+        before_calls, before = calls[0], view.counts.copy()
+        free, motions = steps, 0
+        for k in range(1, steps + 1):  # the oracle: one step at a time
+            a[0], a[1] = chain[k - 1] if outward else chain[k]
+            b[0], b[1] = chain[k] if outward else chain[k - 1]
+            if not outward and not reference.isValid(a):
+                free = k - 1
+                break
+            motions += 1
+            if not reference.checkMotion(a, b):
+                free = k - 1
+                break
+        assert call(view, chain, steps, outward) == free
+        assert view.counts[Count.STATES] - before[Count.STATES] == calls[0] - before_calls
+        assert view.counts[Count.MOTIONS] - before[Count.MOTIONS] == motions
+        taken.append(free)
+    assert any(free == 0 for free in taken) and any(free > 1 for free in taken)
+    exits_per_chain = view.counts[Count.EXITS] / len(taken)
+    assert exits_per_chain > 1 if rows == 3 else exits_per_chain == 1
 
 
 @pytest.mark.parametrize("kind", list(KINDS))

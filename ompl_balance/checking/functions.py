@@ -11,11 +11,12 @@ returns a :class:`CheckFunction`, one of four kinds (:data:`KINDS`):
     a numba ``cfunc`` of signature ``boolean(CPointer(float64), intp)`` (the state's values and
     their number): the engine calls its address as it is (a ``cfunc`` cannot report an error);
 ``vectorized``
-    ``fn(Q) -> (n,) bools`` of an ``(n, d)`` float64 array: called once per motion with every
-    state OMPL's discrete rule would test;
+    ``fn(Q) -> (n,) bools`` of an ``(n, d)`` float64 array: called once per growth of a tree
+    (an extension step's motion; all the steps of a connect) with every state OMPL's discrete
+    rule would test;
 ``python``
     any other callable ``fn(q) -> bool`` of a 1-D float64 array: called once per state, from
-    one call into Python per motion.
+    one call into Python per growth of a tree.
 
 ``q`` holds the state's values in the flat layout of :mod:`ompl_balance.core.layout` (OMPL's
 ``copyFromReals`` order). A function's error reaches the caller as a :class:`CheckerError`
@@ -245,9 +246,23 @@ def _check_cfunc_signature(function: Any, name: str) -> None:
         )
 
 
+#: The attribute of a numba function holding its C wrapper (:func:`_wrapped`), made once per function.
+_WRAPPER = "_ompl_balance_state_function"
+
+
 def _wrapped(function: Any, name: str) -> Any:
     """A C wrapper of numba function ``function`` (see :class:`CheckFunction`'s ``address``): its
-    error is caught (-1) rather than lost in C, and its return type must be a boolean."""
+    error is caught (-1) rather than lost in C, and its return type must be a boolean. Compiled
+    once per function (it takes about as long as the function's own compilation) and kept on the
+    function, so that a checker set up again with the same function costs nothing."""
+    made = getattr(function, _WRAPPER, None)
+    if made is None:
+        made = _compile_wrapper(function, name)
+        setattr(function, _WRAPPER, made)  # (a reference cycle through the wrapper: collected with it)
+    return made
+
+
+def _compile_wrapper(function: Any, name: str) -> Any:
     from numba import carray, cfunc, types
     from numba.core.errors import NumbaError
 

@@ -2,11 +2,12 @@
 
 A checker that can be called from compiled code offers a *view*: a ``NamedTuple`` of
 arrays (its obstacles, its robot, its scratch space, ...) whose type has compiled
-implementations of the two functions below, registered with ``numba.extending.overload``
-by the module that defines the view. The compiled planning engine
-(:mod:`ompl_balance.engine`) calls them on flat states (:mod:`ompl_balance.core.layout`)
-without knowing which checker is behind the view; numba compiles the engine once per
-type of view and caches it on disk.
+implementations of :func:`state_free` and :func:`motion_free`, registered with
+``numba.extending.overload`` by the module that defines the view (and, where checking a
+tree's steps together pays, of :func:`steps_free`; other views check them one by one). The
+compiled planning engine (:mod:`ompl_balance.engine`) calls them on flat states
+(:mod:`ompl_balance.core.layout`) without knowing which checker is behind the view; numba
+compiles the engine once per type of view and caches it on disk.
 
 Every view has a ``counts`` field, an int64 array indexed by :class:`Count`, that its
 kernels increment in place: it *is* the checker's work counter (what ``counters()``
@@ -19,7 +20,8 @@ A query a kernel cannot decide in compiled code leaves through one exit, counted
 ``counts[Count.EXITS]``: FCL on a non-convex pair goes through the kernel's ``objmode`` block,
 which looks the Python object up by the integer handle the view carries (:func:`exit_handle`);
 a checker written in Python is called through a C callback
-(:mod:`ompl_balance.core.function_pointers`), once per motion rather than once per state.
+(:mod:`ompl_balance.core.function_pointers`), once per tree's growth (an extension step, or
+all the steps of a connect) rather than once per state.
 
 A check that raises (a user's function) cannot raise through compiled code: its kernel sets
 ``counts[Count.RAISED]`` and answers "not valid"; the engine stops at once and has the object
@@ -71,6 +73,21 @@ def motion_free(view: Any, a: np.ndarray, b: np.ndarray) -> bool:
     decides in ``view.counts``.
     """
     raise TypeError("motion_free is a compiled kernel: call it from numba-compiled code with a checker's view")
+
+
+def steps_free(view: Any, chain: np.ndarray, steps: int, outward: bool) -> int:
+    """How many of the steps ``chain[0] -> chain[1] -> ... -> chain[steps]`` (flat states, rows of
+    ``chain``) a tree can take before the first blocked one: ``steps`` when none is (compiled code only).
+
+    Step ``k`` is checked as RRT-Connect grows a tree: ``outward`` (the start tree) as
+    ``motion_free(chain[k - 1], chain[k])``; otherwise (the goal tree, whose motions run towards
+    its root) as ``state_free(chain[k])`` then ``motion_free(chain[k], chain[k - 1])``. The steps
+    are checked in order and the checks stop at the first blocked step, so the states tested and
+    counted are those of checking the steps one by one. A view may check them all at once (one
+    exit to Python for the lot: :mod:`ompl_balance.core.exit_check_kernels`); any other view checks
+    them one by one with its ``state_free`` and ``motion_free``.
+    """
+    raise TypeError("steps_free is a compiled kernel: call it from numba-compiled code with a checker's view")
 
 
 _TARGETS: dict[int, weakref.ref[Any]] = {}  # handle -> object, held weakly (its entry leaves with it)

@@ -1,5 +1,5 @@
 """The compiled kernels of :class:`~ompl_balance.core.exit_checks.ExitChecks`: states and motions
-checked by Python, a motion's states in one exit."""
+checked by Python, a tree's growth (a motion, or the steps of a connect) in one exit."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ from .function_pointers import call_exit
 from .kernel_cache import njit
 
 _STATES, _MOTION = int(Query.STATES), int(Query.MOTION)
+NO_STEP = 0  # what _ask_rows answers when every state asked about is valid (steps count from 1)
 
 
 @njit(cache=True)
@@ -25,6 +26,54 @@ def _ask(view: ExitChecks, kind: int, count: int) -> int:  # pragma: no cover (c
     if answer < 0:
         view.counts[Count.RAISED] = 1
     return answer
+
+
+@njit(cache=True)
+def _ask_rows(view: ExitChecks, count: int) -> int:  # pragma: no cover (compiled)
+    """Ask Python for the first invalid state of ``view.rows[:count]`` (tagged in ``view.row_steps``)
+    and count the states tested and the motions begun; the step of the first invalid state, or
+    ``NO_STEP`` when all are valid (when the check raised: the step of the first row)."""
+    tags = view.row_steps
+    first = _ask(view, _STATES, count)
+    if first < 0:
+        return tags[0] // 2
+    tested = min(first + 1, count)
+    view.counts[Count.STATES] += tested
+    for row in range(tested):
+        view.counts[Count.MOTIONS] += tags[row] & 1
+    return tags[first] // 2 if first < count else NO_STEP
+
+
+@njit(cache=True)
+def _queue_motion(
+    view: ExitChecks, a: np.ndarray, b: np.ndarray, step: int, a_first: bool, filled: int
+) -> tuple[int, int]:  # pragma: no cover (compiled)
+    """Append to ``view.rows[filled:]`` the states step ``step`` tests by OMPL's discrete rule for
+    the motion ``a -> b`` (``a`` first when ``a_first``: a goal tree's new state; then ``b``, then
+    those between in the rule's order, :mod:`~ompl_balance.core.discrete_motions`), asking Python
+    about the rows whenever they are full. Returns the rows filled and the blocked step found by
+    an ask (``NO_STEP``: none yet)."""
+    layout, rows, tags, queue, order = view.layout, view.rows, view.row_steps, view.queue, view.order
+    n = max(segment_count(layout, a, b), 1)
+    if order.shape[0] < n:  # a motion longer than the scratch was sized for
+        queue, order = np.empty((n, 2), dtype=np.int64), np.empty(n, dtype=np.int64)
+    bisection_order(n, queue, order)
+    for k in range(-1 if a_first else 0, n):  # -1: a, 0: b, then order[k - 1] / n of the way
+        if filled == rows.shape[0]:
+            blocked = _ask_rows(view, filled)
+            if blocked != NO_STEP:
+                return filled, blocked
+            filled = 0
+        row = rows[filled]
+        if k < 1:
+            source = a if k < 0 else b
+            for i in range(source.shape[0]):
+                row[i] = source[i]
+        else:
+            interpolate(layout, a, b, order[k - 1] / n, row)
+        tags[filled] = 2 * step + (1 if k == 0 else 0)
+        filled += 1
+    return filled, NO_STEP
 
 
 @njit(cache=True)
@@ -42,38 +91,43 @@ def exit_state_free(view: ExitChecks, q: np.ndarray) -> bool:  # pragma: no cove
 def exit_motion_free(view: ExitChecks, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """Whether the motion ``a -> b`` is valid (``a`` taken as valid).
 
-    Batched: the states OMPL's discrete rule tests (``b``, then those between in its order,
-    :mod:`~ompl_balance.core.discrete_motions`), written into ``view.rows`` and handed to Python
-    in one exit (in as many as the rows need, each stopping at the first invalid state),
-    counting the motion and the states decided. Otherwise one exit that asks for the motion.
+    Batched: the states OMPL's discrete rule tests, handed to Python in one exit (in as many as
+    the rows need), counting the motion and the states decided. Otherwise one exit that asks for
+    the motion.
     """
-    layout, rows, queue, order = view.layout, view.rows, view.queue, view.order
     if not view.batched:
+        rows = view.rows
         for i in range(a.shape[0]):
             rows[0, i], rows[1, i] = a[i], b[i]
         return _ask(view, _MOTION, 2) == 1
-    view.counts[Count.MOTIONS] += 1
-    n = max(segment_count(layout, a, b), 1)
-    if order.shape[0] < n:  # a motion longer than the scratch was sized for
-        queue, order = np.empty((n, 2), dtype=np.int64), np.empty(n, dtype=np.int64)
-    bisection_order(n, queue, order)
-    done = 0  # states tested so far: b is the first
-    while done < n:
-        count = min(n - done, rows.shape[0])
-        for k in range(count):
-            if done + k == 0:
-                for i in range(b.shape[0]):
-                    rows[0, i] = b[i]
+    filled, blocked = _queue_motion(view, a, b, 1, False, 0)
+    return blocked == NO_STEP and _ask_rows(view, filled) == NO_STEP
+
+
+@njit(cache=True)
+def exit_steps_free(view: ExitChecks, chain: np.ndarray, steps: int, outward: bool) -> int:  # pragma: no cover
+    """:func:`~ompl_balance.core.checks.steps_free`: batched, every state the steps test in one
+    exit (in as many as the rows need), in the order and with the counts of checking them one by
+    one; otherwise a state and a motion at a time."""
+    if not view.batched:
+        for k in range(1, steps + 1):
+            if outward:
+                free = exit_motion_free(view, chain[k - 1], chain[k])
             else:
-                interpolate(layout, a, b, order[done + k - 1] / n, rows[k])
-        first_invalid = _ask(view, _STATES, count)
-        if first_invalid < 0:
-            return False
-        view.counts[Count.STATES] += min(first_invalid + 1, count)
-        if first_invalid < count:
-            return False
-        done += count
-    return True
+                free = exit_state_free(view, chain[k]) and exit_motion_free(view, chain[k], chain[k - 1])
+            if not free:
+                return k - 1
+        return steps
+    filled = 0
+    for k in range(1, steps + 1):
+        if outward:
+            filled, blocked = _queue_motion(view, chain[k - 1], chain[k], k, False, filled)
+        else:
+            filled, blocked = _queue_motion(view, chain[k], chain[k - 1], k, True, filled)
+        if blocked != NO_STEP:
+            return blocked - 1
+    blocked = _ask_rows(view, filled)
+    return steps if blocked == NO_STEP else blocked - 1
 
 
-register_kernels(ExitChecks, state=exit_state_free, motion=exit_motion_free)
+register_kernels(ExitChecks, state=exit_state_free, motion=exit_motion_free, steps=exit_steps_free)

@@ -8,7 +8,10 @@ write the states a query is about into :attr:`ExitChecks.rows` and make one exit
 ``target`` answers. With ``batched`` a motion checked by OMPL's discrete rule goes to Python
 once, with all the states ``DiscreteMotionValidator::checkMotion`` would test, in its order
 (:mod:`ompl_balance.core.discrete_motions`); the target tests them in that order until the
-first invalid one, so the answer, and the states tested, are OMPL's. Without ``batched``
+first invalid one, so the answer, and the states tested, are OMPL's. The steps a tree takes
+in one growth (a goal tree's new state and its motion; the steps of a connect) go to Python
+together in the same way (:func:`~ompl_balance.core.checks.steps_free`): one exit where one
+step at a time would make one or two per step. Without ``batched``
 each query is its own exit (``si.isValid`` or ``si.checkMotion``, for a motion validator of
 the user's own).
 
@@ -45,24 +48,35 @@ class ExitChecks(NamedTuple):
     SIGINT only sets a flag, acted on between slices: ``engine.driver.interrupts_between_slices``.)
 
     ``rows`` (capacity, dim) holds the states a query is about, written by compiled code and
-    read by the target; ``queue`` (capacity, 2) and ``order`` (capacity,) are the bisection's
-    scratch; ``counts`` the work counter (batched: states and motions; always: exits).
+    read by the target; ``row_steps`` (capacity,) says what each row of a query about a tree's
+    steps is: twice the step (from 1) its state belongs to, plus one for the first state the step's
+    motion tests (the others: the states between, and a goal tree's new state, tested before its
+    motion); ``queue`` (longest, 2) and ``order`` (longest,) are the
+    bisection's scratch; ``counts`` the work counter (batched: states and motions; always: exits).
     """
 
     address: int
     handle: int
     layout: SpaceLayout
     rows: np.ndarray
+    row_steps: np.ndarray
     queue: np.ndarray
     order: np.ndarray
     counts: np.ndarray
     batched: bool
 
 
+#: Rows of a batched view per state of the space's longest motion: room for a connect across the
+#: space, whose steps' motions add up to about one longest motion, plus their new states.
+ROWS_PER_LONGEST = 2
+
+
 def exit_checks(target: Any, layout: SpaceLayout, extent: float, counts: np.ndarray, batched: bool) -> ExitChecks:
     """The :class:`ExitChecks` of ``target`` (an object with ``answer`` and ``error``) in a space of
-    ``layout`` and maximum extent ``extent``, counting in ``counts``; rows for the longest motion
-    when ``batched`` (a longer one goes to Python in parts), else for two states."""
+    ``layout`` and maximum extent ``extent``, counting in ``counts``; rows for the states of
+    :data:`ROWS_PER_LONGEST` longest motions when ``batched`` (more go to Python in parts),
+    else for two states."""
     queue, order = bisection_scratch(extent, layout)
-    rows = np.empty((len(order) if batched else 2, layout.dim))
-    return ExitChecks(EXIT_ADDRESS, exit_handle(target), layout, rows, queue, order, counts, batched)
+    rows = np.empty((ROWS_PER_LONGEST * len(order) if batched else 2, layout.dim))
+    row_steps = np.empty(len(rows), dtype=np.int64)
+    return ExitChecks(EXIT_ADDRESS, exit_handle(target), layout, rows, row_steps, queue, order, counts, batched)

@@ -59,7 +59,7 @@ class SolveArrays:
             reals=np.zeros(Real.COUNT),
             block=np.empty((SAMPLE_BLOCK, dim)),
             uniforms=np.empty((SAMPLE_BLOCK, layout.total_draws)),
-            step=np.empty(dim),
+            chain=np.empty((2, dim)),
             target=np.empty(dim),
             record=np.empty((0, Record.COUNT), dtype=np.int64),
             record_target=np.empty((0, dim)),
@@ -94,9 +94,10 @@ class SolveArrays:
         self.costs = [np.empty(capacity) for capacity in capacities]
         self.distances = [np.empty(capacity) for capacity in capacities]
 
-    def start(self, solve: Solve, room: int, record: bool) -> None:
+    def start(self, solve: Solve, room: int, record: bool, steps_together: bool) -> None:
         """Ready the arrays for ``solve`` (``room``: the nodes an iteration may add; ``record``:
-        whether the loop records what it does)."""
+        whether the loop records what it does; ``steps_together``: whether its checks take a
+        connect's steps together, which the chain then has rows for: at most ``room``)."""
         start_tree, goal_tree = solve.start_tree, solve.goal_tree
         assert isinstance(start_tree, ArrayTree) and isinstance(goal_tree, ArrayTree)
         self.hold(start_tree, goal_tree)
@@ -109,6 +110,9 @@ class SolveArrays:
             self.loop = self.loop._replace(
                 record=np.empty((rows, Record.COUNT), dtype=np.int64), record_target=np.empty((rows, self.layout.dim))
             )
+        chain_rows = room + 1 if steps_together else 2
+        if len(self.loop.chain) != chain_rows:
+            self.loop = self.loop._replace(chain=np.empty((chain_rows, self.layout.dim)))
         self._fitted = False  # (the arrays may have moved since the last solve)
         self.make_room()
 
@@ -253,7 +257,7 @@ def run(
     in ``arrays`` (``key``: the :func:`~ompl_balance.engine.loading.view_key` of ``checks.view``
     and the layout; ``room``: the nodes an iteration may add)."""
     settings = arrays.settings_for(solve.points, solve.settings, solve.record is not None)
-    arrays.start(solve, room, settings.record)
+    arrays.start(solve, room, settings.record, checks.steps_together)
     layout, ints, reals = arrays.layout, arrays.loop.ints, arrays.loop.reals
     state = solve.swap_state
     ints[Slot.GREW_START], ints[Slot.STEPS], ints[Slot.COLLIDED] = state.grew_start, state.steps, state.collided

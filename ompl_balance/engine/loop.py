@@ -29,7 +29,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from .. import policies
-from ..core.checks import Count, motion_free, state_free
+from ..core.checks import Count, steps_free
 from ..core.compiled_spaces import distance, equal, interpolate, row_distance, samples_from_uniforms, segment_count
 from ..core.kernel_cache import njit, njit_borrowing
 from ..core.layout import SpaceLayout
@@ -130,7 +130,8 @@ class Loop(NamedTuple):
 
     ``sizes`` (2,): nodes in the start and goal tree. ``ints`` (:class:`Slot`) and ``reals``
     (:class:`Real`): the loop's state. ``block`` (256, dim) uniform samples, refilled from
-    ``uniforms`` (256, draws). ``step`` (dim,) and ``target`` (dim,): scratch. ``record``
+    ``uniforms`` (256, draws). ``chain`` (steps + 1, dim): the steps a growth checks together
+    (:func:`_grow`; two rows: one step at a time). ``target`` (dim,): scratch. ``record``
     (rows, :class:`Record`) and ``record_target`` (rows, dim): what each iteration did.
     """
 
@@ -139,7 +140,7 @@ class Loop(NamedTuple):
     reals: np.ndarray
     block: np.ndarray
     uniforms: np.ndarray
-    step: np.ndarray
+    chain: np.ndarray
     target: np.ndarray
     record: np.ndarray
     record_target: np.ndarray
@@ -229,46 +230,22 @@ def _node_towards(
     return given, distance(layout, trees[t].states[given], target)
 
 
-@njit(cache=True, inline="always")
-def _extend(
-    checks: Any,
+@njit_borrowing
+def _add_step(
     layout: SpaceLayout,
     settings: LoopSettings,
-    trees: tuple[Tree, Tree],
+    tree: Tree,
     loop: Loop,
     t: int,
-    target: np.ndarray,
+    near: np.ndarray,
+    new: np.ndarray,
     node: int,
-    gap: float,
-) -> tuple[int, int]:  # pragma: no cover (compiled)
-    """Extend tree ``t`` one step from ``node`` (``gap`` from ``target``) towards ``target``.
-
-    Returns the outcome (:class:`~ompl_balance.engine.events.Grow`) and the node added. As the
-    Python engine's ``Extender``: motions in the start tree run outwards, in the goal tree from
-    the new state in (the new state checked first); a motion in collision counts as a failed
-    extension of ``node`` for the nearest policies that count failures.
-    """
-    tree = trees[t]
-    near = tree.states[node]
-    reach = gap <= settings.range
-    if reach:
-        new = target
-    else:
-        interpolate(layout, near, target, settings.range / gap, loop.step)
-        new = loop.step
-        if settings.step_may_stall and equal(layout, near, new):
-            return _TRAPPED, NO_NODE
-    if t == START:  # noqa: SIM108 (the two directions read as OMPL writes them)
-        valid = motion_free(checks, near, new)
-    else:
-        valid = state_free(checks, new) and motion_free(checks, new, near)
-    if not valid:
-        if settings.nearest_policy != _EUCLIDEAN:  # (the policies that rank count failures)
-            tree.failures[node] += 1
-        return _TRAPPED, NO_NODE
+) -> int:  # pragma: no cover (compiled)
+    """Add to tree ``t`` the step from its node ``node`` (at ``near``) to ``new``: the node at ``new``
+    (with ``intermediate_states``, first the states along the motion, ordered away from the
+    tree's root); returns the node added last."""
     added = node
     if settings.intermediate_states:
-        # the states along the motion, ordered away from the tree's root
         count = segment_count(layout, near, new)
         for step in range(1, count):
             interpolate(layout, near, new, step / count, loop.target)
@@ -278,15 +255,91 @@ def _extend(
     _add(tree, loop.sizes[t], new, added)
     added = loop.sizes[t]
     loop.sizes[t] += 1
-    return (_REACHED if reach else _ADVANCED), added
+    return added
 
 
 @njit(cache=True)
-def _note_step(
-    loop: Loop, kind: int, t: int, node: int, given: int, outcome: int, added: int, target: np.ndarray
+def _step_taken(
+    settings: LoopSettings,
+    loop: Loop,
+    connect: bool,
+    t: int,
+    node: int,
+    given: bool,
+    outcome: int,
+    added: int,
+    target: np.ndarray,
 ) -> None:  # pragma: no cover (compiled)
-    row = _note(loop, loop.ints[Slot.ITERATIONS], kind, 1 - t, node, int(given != NO_NODE), outcome, added)
-    _copy(target, loop.record_target[row])
+    """Count a connect's step (the swap limiter's steps) and, when recording, note the step."""
+    if connect:
+        loop.ints[Slot.STEPS] += 1
+    if settings.record:
+        kind = _CONNECT_STEP if connect else _EXTENSION
+        row = _note(loop, loop.ints[Slot.ITERATIONS], kind, 1 - t, node, int(given), outcome, added)
+        _copy(target, loop.record_target[row])
+
+
+@njit(cache=True, inline="always")
+def _grow(
+    checks: Any,
+    layout: SpaceLayout,
+    settings: LoopSettings,
+    trees: tuple[Tree, Tree],
+    loop: Loop,
+    t: int,
+    target: np.ndarray,
+    node: int,
+    gap: float,
+    given: bool,
+    connect: bool,
+) -> tuple[int, int]:  # pragma: no cover (compiled)
+    """Grow tree ``t`` from ``node`` (``gap`` from ``target``; ``given``: the sample policy chose the
+    node) towards ``target``: one step of at most ``range`` (the extension), or with ``connect``
+    steps until one is trapped or reaches ``target``.
+
+    Returns the outcome of the last step (:class:`~ompl_balance.engine.events.Grow`) and the
+    node it added. As the Python engine's ``Extender``: motions in the start tree run outwards,
+    in the goal tree from the new state in (the new state checked first); a step in collision
+    counts as a failed extension of its node for the nearest policies that count failures. The
+    steps ahead are laid out in ``loop.chain`` and checked together
+    (:func:`~ompl_balance.core.checks.steps_free`: one exit to Python for a checker written in
+    Python, where one step at a time makes one or two per step), as many as the chain holds at a
+    time; the states tested, the nodes added and the record are those of one step at a time.
+    """
+    tree, chain = trees[t], loop.chain
+    while True:
+        # the steps ahead: chain[0] the node grown from, chain[k] where step k ends
+        _copy(tree.states[node], chain[0])
+        steps, reached, stalled = 0, False, False
+        while steps + 1 < chain.shape[0] and not reached and (connect or steps == 0):
+            if gap <= settings.range:
+                _copy(target, chain[steps + 1])
+                reached = True
+            else:
+                interpolate(layout, chain[steps], target, settings.range / gap, chain[steps + 1])
+                if settings.step_may_stall and equal(layout, chain[steps], chain[steps + 1]):
+                    stalled = True  # a step that rounds back onto its start: trapped, unchecked
+                    break
+                gap = distance(layout, chain[steps + 1], target)
+            steps += 1
+        free = steps_free(checks, chain, steps, t == START) if steps > 0 else 0
+        for k in range(1, free + 1):
+            added = _add_step(layout, settings, tree, loop, t, chain[k - 1], chain[k], node)
+            outcome = _REACHED if reached and k == steps else _ADVANCED
+            _step_taken(settings, loop, connect, t, node, given, outcome, added, target)
+            node, given = added, True  # (a connect's next step extends the node just added)
+        if checks.counts[Count.RAISED] != 0:
+            return _TRAPPED, NO_NODE
+        if free < steps or stalled:
+            if free < steps and settings.nearest_policy != _EUCLIDEAN:  # (the policies that rank count failures)
+                tree.failures[node] += 1
+            _step_taken(settings, loop, connect, t, node, given, _TRAPPED, NO_NODE, target)
+            return _TRAPPED, NO_NODE
+        if reached:
+            return _REACHED, node
+        if not connect:
+            return _ADVANCED, node
+        # a connect longer than the chain: on from the node added last
 
 
 @njit_borrowing
@@ -419,26 +472,18 @@ def run(
             continue
         target = trees[o].states[0] if row == OTHER_ROOT else loop.block[row]
         node, gap = _node_towards(settings, layout, trees, loop, t, target, given)
-        grown, added = _extend(checks, layout, settings, trees, loop, t, target, node, gap)
+        grown, added = _grow(checks, layout, settings, trees, loop, t, target, node, gap, given != NO_NODE, False)
         if checks.counts[Count.RAISED] != 0:
             return Stop.RAISED
-        if settings.record:
-            _note_step(loop, _EXTENSION, t, node, given, grown, added, target)
         if grown == _TRAPPED:
             continue
         # connect: walk the other tree towards the state just added until trapped or there;
         # each further step extends the node just added (see policies.NearestChoice)
         reach = trees[t].states[added]  # stays put: only the other tree grows while connecting
-        connected, reached, given = _ADVANCED, NO_NODE, NO_NODE
-        while connected == _ADVANCED:
-            node, gap = _node_towards(settings, layout, trees, loop, o, reach, given)
-            connected, reached = _extend(checks, layout, settings, trees, loop, o, reach, node, gap)
-            if checks.counts[Count.RAISED] != 0:
-                return Stop.RAISED
-            if settings.record:
-                _note_step(loop, _CONNECT_STEP, o, node, given, connected, reached, reach)
-            ints[Slot.STEPS] += 1
-            given = reached
+        node, gap = _node_towards(settings, layout, trees, loop, o, reach, NO_NODE)
+        connected, reached = _grow(checks, layout, settings, trees, loop, o, reach, node, gap, False, True)
+        if checks.counts[Count.RAISED] != 0:
+            return Stop.RAISED
         # OMPL's "approx goal distance": the other tree's nearest node to the state just added
         if connected == _REACHED:
             gap = 0.0

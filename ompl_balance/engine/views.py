@@ -28,7 +28,7 @@ from ompl import base as ob
 from ..core.checks import Count, exits_to_python, new_counts
 from ..core.counting import CountingValidityChecker, validity
 from ..core.discrete_motions import discrete_motions
-from ..core.exit_checks import Query, exit_checks
+from ..core.exit_checks import ExitChecks, Query, exit_checks
 from ..core.layout import SpaceLayout
 
 
@@ -84,12 +84,16 @@ class EngineChecks:
     validator, their compiled view, the layout), by identity. ``exits``: whether its kernels may
     call Python through numba's ``objmode`` (see :func:`~ompl_balance.core.checks.exits_to_python`).
     ``reporter``: the object that raises an error a check kept (its ``raise_error()``), if any.
+    ``steps_together``: whether its kernels check a tree's steps in one call to Python (a
+    batched :class:`~ompl_balance.core.exit_checks.ExitChecks`), so the loop lays a whole
+    connect out for them at once.
     """
 
     def __init__(self, view: Any, path: str, source: tuple[Any, ...], reporter: Any = None) -> None:
         self.view = view
         self.path = path
         self.exits = exits_to_python(view)
+        self.steps_together = isinstance(view, ExitChecks) and view.batched
         self.source = source
         self.reporter = reporter  # also keeps an exit's target alive (the registry holds it weakly)
 
