@@ -483,6 +483,20 @@ def test_a_vectorized_function_of_the_wrong_shape_or_dtype_is_refused(returned, 
         ss.solve(1.0)
 
 
+def test_a_numba_function_is_wrapped_once_for_every_checker_set_up_with_it():
+    """The C wrapper of a numba function is compiled the first time setup_checker is given it;
+    checkers set up again with the function (a fresh SimpleSetup per run, as benchmarks make
+    them) call the same machine code, and a new function gets its own."""
+    addresses = [square(numba_free).getSpaceInformation().getStateValidityChecker().function.address for _ in range(3)]
+    assert addresses[0] != 0 and addresses.count(addresses[0]) == 3
+
+    @numba.njit
+    def other(q):
+        return q[0] < 0.5
+
+    assert square(other).getSpaceInformation().getStateValidityChecker().function.address not in addresses
+
+
 def test_a_cfunc_is_called_as_it_is():
     signature = numba.types.boolean(numba.types.CPointer(numba.types.float64), numba.types.intp)
 
