@@ -33,7 +33,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from ..core.checks import Count
-from ..core.exit_checks import Query
+from ..core.exit_checks import Query, row_chunks
 
 #: The kinds of function (see the module docstring).
 KINDS = ("numba", "cfunc", "vectorized", "python")
@@ -149,16 +149,19 @@ class CheckFunction:
                 if not self.check(states[index]):
                     return index
             return count
-        try:
-            valid = self._vectorized(states)
-        except CheckerError:
-            raise
-        except Exception as error:
-            raise CheckerError(
-                f"the validity function {self.name} raised {_error_text(error)} on {count} states"
-            ) from error
-        invalid = np.flatnonzero(~valid)
-        return int(invalid[0]) if len(invalid) else count
+        for first, last in row_chunks(count):
+            try:
+                valid = self._vectorized(states[first:last])
+            except CheckerError:
+                raise
+            except Exception as error:
+                raise CheckerError(
+                    f"the validity function {self.name} raised {_error_text(error)} on {last - first} states"
+                ) from error
+            invalid = np.flatnonzero(~valid)
+            if len(invalid):
+                return first + int(invalid[0])
+        return count
 
     def raise_error(self) -> NoReturn:
         """Raise the error compiled code met: an exit's (``error``) or that of the compiled check at

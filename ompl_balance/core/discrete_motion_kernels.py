@@ -38,7 +38,7 @@ def bisection_order(n: int, queue: np.ndarray, order: np.ndarray) -> None:  # pr
             tail += 1
 
 
-@njit(cache=True, inline="always")
+@njit_borrowing
 def discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """OMPL's ``DiscreteMotionValidator::checkMotion(a, b)`` with the state kernel of ``view.states``:
     ``b``, then the states between in its order (:mod:`ompl_balance.core.discrete_motions`) until
@@ -51,11 +51,13 @@ def discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) ->
     n = segment_count(layout, a, b)
     if n < 2:
         return True
-    if order.shape[0] < n:  # a motion longer than the scratch was sized for
-        queue, order = np.empty((n, 2), dtype=np.int64), np.empty(n, dtype=np.int64)
-    bisection_order(n, queue, order)
+    # a motion longer than the space's longest (an end outside the bounds: the scratch has no
+    # room for its order) has its states tested in order from a
+    in_order = order.shape[0] < n
+    if not in_order:
+        bisection_order(n, queue, order)
     for k in range(n - 1):
-        interpolate(layout, a, b, order[k] / n, test)
+        interpolate(layout, a, b, (k + 1 if in_order else order[k]) / n, test)
         if not state_free(states, test):
             return False
     return True

@@ -11,13 +11,13 @@ from .compiled_spaces import interpolate, segment_count
 from .discrete_motion_kernels import bisection_order
 from .exit_checks import ExitChecks, Query
 from .function_pointers import call_exit
-from .kernel_cache import njit
+from .kernel_cache import njit_borrowing
 
 _STATES, _MOTION = int(Query.STATES), int(Query.MOTION)
 NO_STEP = 0  # what _ask_rows answers when every state asked about is valid (steps count from 1)
 
 
-@njit(cache=True)
+@njit_borrowing
 def _ask(view: ExitChecks, kind: int, count: int) -> int:  # pragma: no cover (compiled)
     """One exit to the view's target about ``view.rows[:count]`` (counted); -1, with the view's
     RAISED flag set, when it raised."""
@@ -28,7 +28,7 @@ def _ask(view: ExitChecks, kind: int, count: int) -> int:  # pragma: no cover (c
     return answer
 
 
-@njit(cache=True)
+@njit_borrowing
 def _ask_rows(view: ExitChecks, count: int) -> int:  # pragma: no cover (compiled)
     """Ask Python for the first invalid state of ``view.rows[:count]`` (tagged in ``view.row_steps``)
     and count the states tested and the motions begun; the step of the first invalid state, or
@@ -44,7 +44,7 @@ def _ask_rows(view: ExitChecks, count: int) -> int:  # pragma: no cover (compile
     return tags[first] // 2 if first < count else NO_STEP
 
 
-@njit(cache=True)
+@njit_borrowing
 def _queue_motion(
     view: ExitChecks, a: np.ndarray, b: np.ndarray, step: int, a_first: bool, filled: int
 ) -> tuple[int, int]:  # pragma: no cover (compiled)
@@ -55,9 +55,11 @@ def _queue_motion(
     an ask (``NO_STEP``: none yet)."""
     layout, rows, tags, queue, order = view.layout, view.rows, view.row_steps, view.queue, view.order
     n = max(segment_count(layout, a, b), 1)
-    if order.shape[0] < n:  # a motion longer than the scratch was sized for
-        queue, order = np.empty((n, 2), dtype=np.int64), np.empty(n, dtype=np.int64)
-    bisection_order(n, queue, order)
+    # the states between in the rule's order; a motion longer than the space's longest (an end
+    # outside the bounds: the scratch has no room for its order) has them in order from a
+    in_order = order.shape[0] < n
+    if not in_order:
+        bisection_order(n, queue, order)
     for k in range(-1 if a_first else 0, n):  # -1: a, 0: b, then order[k - 1] / n of the way
         if filled == rows.shape[0]:
             blocked = _ask_rows(view, filled)
@@ -70,13 +72,13 @@ def _queue_motion(
             for i in range(source.shape[0]):
                 row[i] = source[i]
         else:
-            interpolate(layout, a, b, order[k - 1] / n, row)
+            interpolate(layout, a, b, (k if in_order else order[k - 1]) / n, row)
         tags[filled] = 2 * step + (1 if k == 0 else 0)
         filled += 1
     return filled, NO_STEP
 
 
-@njit(cache=True)
+@njit_borrowing
 def exit_state_free(view: ExitChecks, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
     """Whether ``q`` is valid: one exit (a state counted here where the view is batched)."""
     rows = view.rows
@@ -87,7 +89,7 @@ def exit_state_free(view: ExitChecks, q: np.ndarray) -> bool:  # pragma: no cove
     return _ask(view, _STATES, 1) == 1
 
 
-@njit(cache=True)
+@njit_borrowing
 def exit_motion_free(view: ExitChecks, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """Whether the motion ``a -> b`` is valid (``a`` taken as valid).
 
@@ -104,7 +106,7 @@ def exit_motion_free(view: ExitChecks, a: np.ndarray, b: np.ndarray) -> bool:  #
     return blocked == NO_STEP and _ask_rows(view, filled) == NO_STEP
 
 
-@njit(cache=True)
+@njit_borrowing
 def exit_steps_free(view: ExitChecks, chain: np.ndarray, steps: int, outward: bool) -> int:  # pragma: no cover
     """:func:`~ompl_balance.core.checks.steps_free`: batched, every state the steps test in one
     exit (in as many as the rows need), in the order and with the counts of checking them one by

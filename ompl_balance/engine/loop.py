@@ -202,7 +202,7 @@ def _add(tree: Tree, size: int, state: np.ndarray, parent: int) -> None:  # prag
     tree.failures[size] = 0
 
 
-@njit(cache=True)
+@njit_borrowing
 def _note(loop: Loop, iteration: int, kind: int, a: int, b: int, c: int, d: int, e: int) -> int:  # pragma: no cover
     """Append a row to the loop record (columns of :class:`Record`); returns its index."""
     row = loop.ints[Slot.RECORDED]
@@ -258,7 +258,7 @@ def _add_step(
     return added
 
 
-@njit(cache=True)
+@njit_borrowing
 def _step_taken(
     settings: LoopSettings,
     loop: Loop,
@@ -403,7 +403,7 @@ def _target(
     return 0, NO_NODE, False
 
 
-@njit(cache=True)
+@njit_borrowing
 def run(
     checks: Any,
     layout: SpaceLayout,

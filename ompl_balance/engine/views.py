@@ -28,7 +28,7 @@ from ompl import base as ob
 from ..core.checks import Count, exits_to_python, new_counts
 from ..core.counting import CountingValidityChecker, validity
 from ..core.discrete_motions import discrete_motions
-from ..core.exit_checks import ExitChecks, Query, exit_checks
+from ..core.exit_checks import ExitChecks, Query, exit_checks, row_chunks
 from ..core.layout import SpaceLayout
 
 
@@ -43,22 +43,29 @@ class SpaceChecks:
 
     def __init__(self, si: ob.SpaceInformation, is_valid: Callable[[ob.State], Any]) -> None:
         self.error: BaseException | None = None
-        self.rows = np.empty((0, 0))  # the view's rows (set once the view is made)
+        self.rows = np.empty((0, 0))  # the view's rows (set by take_rows once the view is made)
+        self._chunks: list[tuple[tuple[int, int], ...]] = []  # row_chunks(count) for every count
         self._si = si
         self._scratch = (si.allocState(), si.allocState())
         self._is_valid = is_valid
         self._copy = si.getStateSpace().copyFromReals
+
+    def take_rows(self, rows: np.ndarray) -> None:
+        """Answer about ``rows`` (the view's, (capacity, dim))."""
+        self.rows = rows
+        self._chunks = [tuple(row_chunks(count)) for count in range(len(rows) + 1)]  # (worked out once: exits are hot)
 
     def answer(self, kind: int, count: int) -> int:
         """The answer to query ``kind`` about ``rows[:count]`` (see :class:`~ompl_balance.core.exit_checks.Query`)."""
         copy, rows = self._copy, self.rows
         if kind == _STATES:
             state, is_valid = self._scratch[0], self._is_valid
-            for index, values in enumerate(rows[:count].tolist()):
-                copy(state, values)
-                valid = is_valid(state)
-                if valid is not True and (valid is False or not validity(valid, is_valid)):
-                    return index
+            for first, last in self._chunks[count]:
+                for index, values in enumerate(rows[first:last].tolist(), first):
+                    copy(state, values)
+                    valid = is_valid(state)
+                    if valid is not True and (valid is False or not validity(valid, is_valid)):
+                        return index
             return count
         start, end = self._scratch
         copy(start, rows[0].tolist())
@@ -131,5 +138,5 @@ def checks_for(si: ob.SpaceInformation, layout: SpaceLayout, previous: EngineChe
     batched = discrete and isinstance(checker, CountingValidityChecker)
     space_checks = SpaceChecks(si, checker.check if batched else si.isValid)
     exits = exit_checks(space_checks, layout, extent, checker.counts if batched else new_counts(), batched)
-    space_checks.rows = exits.rows
+    space_checks.take_rows(exits.rows)
     return EngineChecks(exits, "python", source, space_checks)
