@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numba
 import numpy as np
 import pytest
 from numba.core.caching import FunctionCache
@@ -132,3 +133,38 @@ def test_a_borrowing_kernel_reads_its_callers_arrays_and_refuses_to_allocate():
     assert values.tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]
     with pytest.raises(TypingError):
         _allocates(3)
+
+
+# (not cached, so that each run compiles the callee from its caller, as a fresh install does)
+_BORROWING: dict = {"_nrt": False}
+
+
+@kernel_cache.njit
+def _allocating_kernel(count: int) -> float:  # pragma: no cover (compiled)
+    return float(np.ones(count).sum())
+
+
+@numba.njit(**_BORROWING)
+def _borrowing_caller(count: int) -> float:  # pragma: no cover (compiled)
+    return _allocating_kernel(count)
+
+
+@numba.njit
+def _allocating_unstated(count: int) -> float:  # pragma: no cover (compiled)
+    return float(np.ones(count).sum())
+
+
+@numba.njit(**_BORROWING)
+def _borrowing_caller_of_unstated(count: int) -> float:  # pragma: no cover (compiled)
+    return _allocating_unstated(count)
+
+
+def test_a_package_kernel_that_allocates_compiles_when_a_borrowing_kernel_calls_it_first():
+    # numba compiles a callee with its caller's reference counting unless the callee states its
+    # own: a plain numba kernel first called from a borrowing one cannot allocate ...
+    assert not _allocating_unstated.overloads
+    with pytest.raises(TypingError):
+        _borrowing_caller_of_unstated(3)
+    # ... the package's njit states it, so the planning loop may be the first to call any kernel
+    assert not _allocating_kernel.overloads
+    assert _borrowing_caller(4) == 4.0

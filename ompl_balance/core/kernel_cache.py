@@ -21,12 +21,24 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-from numba import njit
+import numba
 from numba.core import caching
 
 __all__ = ["PackageCacheLocator", "njit", "njit_borrowing", "package_digest"]
 
 _Kernel = TypeVar("_Kernel", bound=Callable[..., Any])
+
+
+def njit(*args: Any, **options: Any) -> Any:
+    """numba's ``njit``, with numba's reference counting stated rather than left to inherit.
+
+    numba compiles a kernel the first time compiled code calls it with the caller's setting of
+    reference counting unless the kernel states its own; a kernel that allocates, first called
+    from a borrowing one (:func:`njit_borrowing`, as the planning loop is), would then fail to
+    compile, or compile, depending on which was compiled first in the process.
+    """
+    options.setdefault("_nrt", True)  # (numba's option for it, undeclared in its stubs)
+    return numba.njit(*args, **options)
 
 
 def njit_borrowing(function: _Kernel) -> _Kernel:
@@ -39,8 +51,8 @@ def njit_borrowing(function: _Kernel) -> _Kernel:
     space's layout and a tree (25 arrays) through three calls cost 1.6 us on a tree of 8 nodes,
     against 26 ns for the scan itself.
     """
-    options: dict[str, Any] = {"cache": True, "_nrt": False}  # (numba's option for it, undeclared in its stubs)
-    return cast(_Kernel, njit(**options)(function))
+    options: dict[str, Any] = {"cache": True, "_nrt": False}  # (numba's option, undeclared in its stubs)
+    return cast(_Kernel, numba.njit(**options)(function))
 
 
 #: The package's folder: functions defined in files below it are cached by :class:`PackageCacheLocator`.

@@ -416,7 +416,12 @@ def run(
     """Run iterations of the loop for ``slice_ns`` nanoseconds (the iteration under way when they
     are over finishes; ``slice_ns <= 0``: none); returns why it stopped (:class:`Stop`). Random
     numbers come from the numpy generator whose bit generator is at address ``bits``
-    (:func:`~ompl_balance.engine.uniforms.bit_generator_address`)."""
+    (:func:`~ompl_balance.engine.uniforms.bit_generator_address`).
+
+    Compiled without numba's reference counts, as every kernel it calls once an iteration or
+    more often (:func:`~ompl_balance.core.kernel_cache.njit_borrowing`): it only borrows the
+    caller's arrays, and counting each of the dozens a view, the trees and the loop hold, at
+    each call and field read, took most of a 2-D solve's time."""
     ints, sizes = loop.ints, loop.sizes
     room = ints[Slot.ROOM]
     deadline = monotonic_ns() + slice_ns
