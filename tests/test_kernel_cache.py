@@ -6,6 +6,7 @@ import importlib
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numba
 import numpy as np
@@ -135,36 +136,29 @@ def test_a_borrowing_kernel_reads_its_callers_arrays_and_refuses_to_allocate():
         _allocates(3)
 
 
-# (not cached, so that each run compiles the callee from its caller, as a fresh install does)
-_BORROWING: dict = {"_nrt": False}
+def _allocating_kernel_and_borrowing_caller(jit: Any) -> tuple[Any, Any]:
+    """A kernel made with ``jit`` that allocates, and a borrowing caller of it: neither compiled
+    yet, nor cached (each run compiles the kernel from its caller, as a fresh install does)."""
 
+    def allocate(count: int) -> float:  # pragma: no cover (compiled)
+        return float(np.ones(count).sum())
 
-@kernel_cache.njit
-def _allocating_kernel(count: int) -> float:  # pragma: no cover (compiled)
-    return float(np.ones(count).sum())
+    kernel = jit(allocate)
 
+    def call(count: int) -> float:  # pragma: no cover (compiled)
+        return kernel(count)
 
-@numba.njit(**_BORROWING)
-def _borrowing_caller(count: int) -> float:  # pragma: no cover (compiled)
-    return _allocating_kernel(count)
-
-
-@numba.njit
-def _allocating_unstated(count: int) -> float:  # pragma: no cover (compiled)
-    return float(np.ones(count).sum())
-
-
-@numba.njit(**_BORROWING)
-def _borrowing_caller_of_unstated(count: int) -> float:  # pragma: no cover (compiled)
-    return _allocating_unstated(count)
+    borrowing: dict[str, Any] = {"_nrt": False}  # (njit_borrowing's setting, without its cache)
+    return kernel, numba.njit(**borrowing)(call)
 
 
 def test_a_package_kernel_that_allocates_compiles_when_a_borrowing_kernel_calls_it_first():
     # numba compiles a callee with its caller's reference counting unless the callee states its
     # own: a plain numba kernel first called from a borrowing one cannot allocate ...
-    assert not _allocating_unstated.overloads
+    _, caller = _allocating_kernel_and_borrowing_caller(numba.njit)
     with pytest.raises(TypingError):
-        _borrowing_caller_of_unstated(3)
+        caller(3)
     # ... the package's njit states it, so the planning loop may be the first to call any kernel
-    assert not _allocating_kernel.overloads
-    assert _borrowing_caller(4) == 4.0
+    kernel, caller = _allocating_kernel_and_borrowing_caller(kernel_cache.njit)
+    assert not kernel.overloads
+    assert caller(4) == 4.0
