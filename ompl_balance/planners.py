@@ -255,10 +255,11 @@ class BalancedRRTConnect(TreePlanner):
         """Make the planner's trees (:meth:`_trees`) and, where the compiled engine is loaded, its
         arrays for them and its settings now (as OMPL's planners allocate at setup and clear: a
         solve's time does not count them)."""
-        start_tree, goal_tree = self._trees()
+        trees = self._trees()
         points = self._points
-        if isinstance(points, ArrayPoints):
-            self._engine.prepare(points, self.settings, self.loop_record is not None, start_tree, goal_tree)
+        if isinstance(points, ArrayPoints) and (room := self._room(points)) <= MAX_ROOM:
+            failures = (self._failures[trees[0]], self._failures[trees[1]])
+            self._engine.prepare(points, self.settings, self.loop_record is not None, trees, failures, room)
 
     def _trees(self) -> tuple[Tree, Tree]:
         """The planner's trees (new, empty ones if it has none) and what the policies keep per node."""
@@ -362,8 +363,7 @@ class BalancedRRTConnect(TreePlanner):
             return None
         points = solve.points
         assert isinstance(points, ArrayPoints)
-        extent = solve.si.getStateSpace().getMaximumExtent()
-        room = room_per_iteration(points.layout, extent, settings.range, settings.intermediate_states)
+        room = self._room(points)
         if room > MAX_ROOM:
             if settings.engine == "compiled":
                 raise ValueError(
@@ -372,6 +372,11 @@ class BalancedRRTConnect(TreePlanner):
                 )
             return None
         return self._engine.run_of(solve, points.layout, room, settings.engine, self.getName())
+
+    def _room(self, points: ArrayPoints) -> int:
+        """The nodes one iteration of the compiled loop may add to a tree (its arrays keep room for them)."""
+        extent = self.getSpaceInformation().getStateSpace().getMaximumExtent()
+        return room_per_iteration(points.layout, extent, self.settings.range, self.settings.intermediate_states)
 
     def _progress_extras(self) -> dict[str, Callable[[], str]]:
         return {

@@ -1,6 +1,7 @@
 """The compiled kernels of :class:`~ompl_balance.core.discrete_motions.DiscreteMotions`, and the order
-in which OMPL's discrete rule tests a motion's states (:func:`bisection_order`), which every
-kernel checking a motion by that rule takes."""
+in which OMPL's discrete rule tests a motion's states (:func:`bisection_order`,
+:func:`order_between`, :func:`fraction_between`), which every kernel checking a motion by that
+rule takes."""
 
 from __future__ import annotations
 
@@ -39,6 +40,25 @@ def bisection_order(n: int, queue: np.ndarray, order: np.ndarray) -> None:  # pr
 
 
 @njit_borrowing
+def order_between(n: int, queue: np.ndarray, order: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    """Ready the order in which the rule tests the states between the ends of a motion of ``n``
+    segments (:func:`bisection_order` into ``order``); ``True`` where ``order`` has no room for
+    it, a motion longer than the space's longest (an end outside the bounds), whose states
+    between are then tested in order from its first end. :func:`fraction_between` reads it."""
+    if order.shape[0] < n:
+        return True
+    bisection_order(n, queue, order)
+    return False
+
+
+@njit_borrowing
+def fraction_between(k: int, n: int, in_order: bool, order: np.ndarray) -> float:  # pragma: no cover (compiled)
+    """Where the ``k``-th state between a motion's ends that the rule tests lies (from 0), as a
+    fraction of the motion (``in_order``, ``order``: see :func:`order_between`)."""
+    return (k + 1 if in_order else order[k]) / n
+
+
+@njit_borrowing
 def discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """OMPL's ``DiscreteMotionValidator::checkMotion(a, b)`` with the state kernel of ``view.states``:
     ``b``, then the states between in its order (:mod:`ompl_balance.core.discrete_motions`) until
@@ -51,13 +71,9 @@ def discrete_motion_free(view: DiscreteMotions, a: np.ndarray, b: np.ndarray) ->
     n = segment_count(layout, a, b)
     if n < 2:
         return True
-    # a motion longer than the space's longest (an end outside the bounds: the scratch has no
-    # room for its order) has its states tested in order from a
-    in_order = order.shape[0] < n
-    if not in_order:
-        bisection_order(n, queue, order)
+    in_order = order_between(n, queue, order)
     for k in range(n - 1):
-        interpolate(layout, a, b, (k + 1 if in_order else order[k]) / n, test)
+        interpolate(layout, a, b, fraction_between(k, n, in_order, order), test)
         if not state_free(states, test):
             return False
     return True

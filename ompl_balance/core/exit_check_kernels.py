@@ -8,7 +8,7 @@ import numpy as np
 from .check_overloads import register_kernels
 from .checks import Count
 from .compiled_spaces import interpolate, segment_count
-from .discrete_motion_kernels import bisection_order
+from .discrete_motion_kernels import fraction_between, order_between
 from .exit_checks import ExitChecks, Query
 from .function_pointers import call_exit
 from .kernel_cache import njit_borrowing
@@ -55,12 +55,8 @@ def _queue_motion(
     an ask (``NO_STEP``: none yet)."""
     layout, rows, tags, queue, order = view.layout, view.rows, view.row_steps, view.queue, view.order
     n = max(segment_count(layout, a, b), 1)
-    # the states between in the rule's order; a motion longer than the space's longest (an end
-    # outside the bounds: the scratch has no room for its order) has them in order from a
-    in_order = order.shape[0] < n
-    if not in_order:
-        bisection_order(n, queue, order)
-    for k in range(-1 if a_first else 0, n):  # -1: a, 0: b, then order[k - 1] / n of the way
+    in_order = order_between(n, queue, order)
+    for k in range(-1 if a_first else 0, n):  # -1: a, 0: b, then the states between in the rule's order
         if filled == rows.shape[0]:
             blocked = _ask_rows(view, filled)
             if blocked != NO_STEP:
@@ -72,7 +68,7 @@ def _queue_motion(
             for i in range(source.shape[0]):
                 row[i] = source[i]
         else:
-            interpolate(layout, a, b, (k if in_order else order[k - 1]) / n, row)
+            interpolate(layout, a, b, fraction_between(k - 1, n, in_order, order), row)
         tags[filled] = 2 * step + (1 if k == 0 else 0)
         filled += 1
     return filled, NO_STEP

@@ -244,14 +244,16 @@ class TreePlanner(ob.Planner):
         self._prepare_generator()
 
     def _prepare_generator(self) -> None:
-        """Make the next solve's generator now where ``seed`` fixes it (at setup and clear, as
-        OMPL's planners allocate: making one costs as much as a short solve's planning)."""
+        """Make the next solve's generator now (at setup and clear, as OMPL's planners allocate:
+        making one costs as much as a short solve's planning); with ``seed = 0`` its seed is
+        drawn now, the draw the solve would make."""
         seed = self.settings.seed
-        self._prepared = (seed, np.random.default_rng(seed)) if seed > 0 else None
+        self._prepared = (seed, np.random.default_rng(seed or self._draw_seed()))
 
     def _generator(self) -> np.random.Generator:
         """A solve's random numbers: a stream started from ``seed`` (every solve starts it
-        again), or with ``seed = 0`` from a seed drawn from the planner's OMPL RNG."""
+        again), or with ``seed = 0`` from a seed drawn from the planner's OMPL RNG (one draw a
+        solve: the generator prepared at setup or clear, else drawn now)."""
         seed = self.settings.seed
         prepared, self._prepared = self._prepared, None
         if prepared is not None and prepared[0] == seed:

@@ -29,7 +29,7 @@ from ompl import util as ou
 from ..core.checks import kernel_modules
 from ..core.layout import SpaceLayout
 from ..core.spaces import ArrayPoints
-from ..core.trees import Tree
+from ..core.trees import ArrayTree, Tree
 from .loading import LOADER, view_key
 from .solve import Solve
 from .views import EngineChecks, checks_for
@@ -146,18 +146,29 @@ class CompiledEngine:
         else:
             LOADER.start(self._key, warm)
 
-    def prepare(self, points: ArrayPoints, settings: Any, record: bool, start_tree: Tree, goal_tree: Tree) -> None:
-        """Make the arrays and the loop's settings of solves on ``start_tree`` and ``goal_tree``
-        now, where the engine is loaded (``settings``: the planner's RRTConnectSettings;
-        ``record``: whether solves record the loop). Planners call this as they make their
-        trees, at setup and clear, which a solve's time does not count."""
+    def prepare(
+        self,
+        points: ArrayPoints,
+        settings: Any,
+        record: bool,
+        trees: tuple[Tree, Tree],
+        failures: tuple[Any, Any],
+        room: int,
+    ) -> None:
+        """Make the arrays and the loop's settings of solves on ``trees`` (start, goal; with their
+        ``failures``) now, where the engine is loaded (``settings``: the planner's
+        RRTConnectSettings; ``record``: whether solves record the loop; ``room``: the nodes an
+        iteration may add). Planners call this as they make their trees, at setup and clear,
+        which a solve's time does not count."""
         if self._key is None or not LOADER.ready(self._key):
             return
         from .driver import SolveArrays
 
         if self._arrays is None or self._arrays.layout is not points.layout:
             self._arrays = SolveArrays(points.layout)
-        self._arrays.hold(start_tree, goal_tree)
+        start_tree, goal_tree = trees
+        assert isinstance(start_tree, ArrayTree) and isinstance(goal_tree, ArrayTree)
+        self._arrays.hold(start_tree, goal_tree, failures, room)
         self._arrays.settings_for(points, settings, record)
 
     def run_of(self, solve: Solve, layout: SpaceLayout, room: int, engine: str, name: str) -> CompiledRun | None:

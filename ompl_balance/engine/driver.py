@@ -11,6 +11,7 @@ counts and loop record hold what the compiled loop did, as if the Python engine 
 
 from __future__ import annotations
 
+import _signal  # (the C module behind signal; see interrupts_between_slices)
 import contextlib
 import signal
 import threading
@@ -82,28 +83,38 @@ class SolveArrays:
             self._settings = (source, loop_settings(settings, points.may_stall(settings.range), record))
         return self._settings[1]
 
-    def hold(self, start_tree: ArrayTree, goal_tree: ArrayTree) -> None:
-        """Keep the index and cost arrays of the planner's trees ``start_tree``, ``goal_tree`` (new
-        ones, sized for the trees' capacity, unless they are the trees held already)."""
+    def hold(self, start_tree: ArrayTree, goal_tree: ArrayTree, failures: tuple[Any, Any], room: int) -> None:
+        """Keep arrays for the planner's trees ``start_tree``, ``goal_tree`` (with their
+        :class:`~ompl_balance.policies.NodeFailures` ``failures``) with room for an iteration that
+        adds ``room`` nodes: their index and cost arrays (new ones, sized for the trees'
+        capacity, unless these are the trees held already) and the loop's view of them
+        (:attr:`trees`)."""
         held = self._planner_trees
-        if len(held) == 2 and held[0] is start_tree and held[1] is goal_tree:
-            return
-        self._planner_trees = (start_tree, goal_tree)
-        capacities = [len(tree.storage().parents) for tree in self._planner_trees]
-        self.indexes = [new_index(self.layout, 0) for _ in capacities]  # (grown once a tree needs it)
-        self.costs = [np.empty(capacity) for capacity in capacities]
-        self.distances = [np.empty(capacity) for capacity in capacities]
+        if not (len(held) == 2 and held[0] is start_tree and held[1] is goal_tree):
+            self._planner_trees = (start_tree, goal_tree)
+            capacities = [len(tree.storage().parents) for tree in self._planner_trees]
+            self.indexes = [new_index(self.layout, 0) for _ in capacities]  # (grown once a tree needs it)
+            self.costs = [np.empty(capacity) for capacity in capacities]
+            self.distances = [np.empty(capacity) for capacity in capacities]
+            self._fitted = False
+        if room != self.room or any(a is not b for a, b in zip(failures, self.failures)):
+            self.failures, self.room, self._fitted = list(failures), room, False
+        self.make_room()
 
     def start(self, solve: Solve, room: int, record: bool, steps_together: bool) -> None:
         """Ready the arrays for ``solve`` (``room``: the nodes an iteration may add; ``record``:
         whether the loop records what it does; ``steps_together``: whether its checks take a
-        connect's steps together, which the chain then has rows for: at most ``room``)."""
+        connect's steps together, which the chain then has rows for: at most ``room``).
+
+        The loop's state starts at zero, but for the sizes the trees' arrays have room for
+        (:meth:`make_room`): they stay true while the planner keeps its trees (their arrays
+        move only as they outgrow them), and the planner fits them at setup."""
         start_tree, goal_tree = solve.start_tree, solve.goal_tree
         assert isinstance(start_tree, ArrayTree) and isinstance(goal_tree, ArrayTree)
-        self.hold(start_tree, goal_tree)
-        self.failures = [solve.failures[start_tree], solve.failures[goal_tree]]
-        self.room = room
-        self.loop.ints[:] = 0
+        ints = self.loop.ints
+        fits = ints[Slot.START_FITS : Slot.GOAL_FITS + 1].tolist()
+        ints[:] = 0
+        ints[Slot.START_FITS : Slot.GOAL_FITS + 1] = fits
         self.loop.reals[:] = 0.0
         rows = 4 * room + 64 if record else 0
         if len(self.loop.record) < rows or (rows == 0 and len(self.loop.record)):
@@ -113,8 +124,7 @@ class SolveArrays:
         chain_rows = room + 1 if steps_together else 2
         if len(self.loop.chain) != chain_rows:
             self.loop = self.loop._replace(chain=np.empty((chain_rows, self.layout.dim)))
-        self._fitted = False  # (the arrays may have moved since the last solve)
-        self.make_room()
+        self.hold(start_tree, goal_tree, (solve.failures[start_tree], solve.failures[goal_tree]), room)
 
     def make_room(self) -> None:
         """Room for one more iteration in both trees (and the record); :attr:`trees`: the trees'
@@ -226,7 +236,8 @@ def interrupts_between_slices(exits: bool) -> Iterator[Callable[[], None]]:
     if not exits or threading.current_thread() is not threading.main_thread():
         yield _nothing
         return
-    handler = signal.getsignal(signal.SIGINT)
+    # (signal's own functions wrap _signal's, turning each handler into an enum: 7 us a solve)
+    handler = _signal.getsignal(signal.SIGINT)
     if not callable(handler):
         yield _nothing
         return
@@ -237,11 +248,11 @@ def interrupts_between_slices(exits: bool) -> Iterator[Callable[[], None]]:
             caught.clear()
             handler(signal.SIGINT, None)
 
-    signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
+    _signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
     try:
         yield check
     finally:
-        signal.signal(signal.SIGINT, handler)
+        _signal.signal(signal.SIGINT, handler)
         check()  # a SIGINT in the last slice
 
 
