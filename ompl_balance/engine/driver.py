@@ -96,9 +96,10 @@ class SolveArrays:
             self.indexes = [new_index(self.layout, 0) for _ in capacities]  # (grown once a tree needs it)
             self.costs = [np.empty(capacity) for capacity in capacities]
             self.distances = [np.empty(capacity) for capacity in capacities]
+            self.failures = list(failures)  # (made with the trees: new trees, new failures)
             self._fitted = False
-        if room != self.room or any(a is not b for a, b in zip(failures, self.failures)):
-            self.failures, self.room, self._fitted = list(failures), room, False
+        if room != self.room:
+            self.room, self._fitted = room, False
         self.make_room()
 
     def start(self, solve: Solve, room: int, record: bool, steps_together: bool) -> None:
