@@ -102,7 +102,7 @@ def _placed(poses: np.ndarray, body: int, points: np.ndarray, i: int) -> Vector:
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def sphere_bounds(
     poses: np.ndarray, volumes: Volumes, model: Model, pairs: np.ndarray, out: np.ndarray
 ) -> None:  # pragma: no cover (compiled)
@@ -143,7 +143,7 @@ def sphere_bounds(
             out[i] = between - volumes.outer_radius[first] - volumes.outer_radius[second] - SLACK
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def hull_bounds(
     pair: int,
     poses: np.ndarray,
@@ -171,8 +171,11 @@ def hull_bounds(
             centre = _placed(poses, body, volumes.outer_centre, g)
             for axis in range(3):
                 warm[pair, axis] = centre[axis] - model.obstacle_centre[o, axis]
+        # (a plain int: numba's literal 0 would compile distance_bounds once more, as it does
+        # for every literal argument of a kernel)
+        obstacles_body = int(0)  # noqa: UP018, RUF046
         lower, upper = distance_bounds(
-            model.parts, g, poses, body, geometries + o, identity, 0, warm, pair, simplex, enough + SLACK
+            model.parts, g, poses, body, geometries + o, identity, obstacles_body, warm, pair, simplex, enough + SLACK
         )
         return lower - SLACK, upper
     first, second = volumes.pairs[pair - environment, 0], volumes.pairs[pair - environment, 1]
@@ -218,7 +221,7 @@ def _table_cell(u: float, cells: int) -> int:  # pragma: no cover (compiled)
     return cell if 0 <= cell < cells else -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def table_span_free(
     a: np.ndarray, delta: np.ndarray, t0: float, t1: float, chain: Chain, volumes: Volumes, table: int
 ) -> bool:  # pragma: no cover (compiled)
@@ -350,7 +353,7 @@ def _parts_touch(lower: np.ndarray, final: np.ndarray, clearance: float) -> bool
     return (final[0] and lower[0] <= clearance) or (final[1] and lower[1] <= clearance)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _exhausted(
     stop: bool,
     bad: float,

@@ -288,9 +288,12 @@ def certified_edge_free(
     counts[Count.MOTIONS] += 1
     start, end = memory_row(memory, a), memory_row(memory, b)
     spent = 0
+    # (``stop`` as a plain bool: numba's literal True would compile advance a second time, 12 s,
+    # beside the entry point the certifier compiles for Python callers)
+    stop = bool(True)  # noqa: UP018 (see above)
     for probe in (True, False):
         failed, bad, hard, evaluated, bounded, hard_pair, hard_span, exhausted = advance(
-            a, b, edge, memory.bounds, start, end, edge.floor, True, probe, scratch, edge.budget - spent
+            a, b, edge, memory.bounds, start, end, edge.floor, stop, probe, scratch, edge.budget - spent
         )
         counts[Count.STATES] += evaluated
         counts[Count.DISTANCE_QUERIES] += bounded

@@ -295,8 +295,11 @@ def hull_bound(
         warm[pair, 0] = x - view.obstacle_centre[o, 0]
         warm[pair, 1] = y - view.obstacle_centre[o, 1]
         warm[pair, 2] = z - view.obstacle_centre[o, 2]
+    # (the body's and the obstacles' row of their poses as a plain int: with numba's literal 0s
+    # the robot layer's compilation of distance_bounds would not serve here)
+    pose_row = int(0)  # noqa: UP018, RUF046
     lower, upper = distance_bounds(
-        view.parts, g, poses, 0, parts + o, view.identity, 0, warm, pair, view.simplex, enough + SLACK
+        view.parts, g, poses, pose_row, parts + o, view.identity, pose_row, warm, pair, view.simplex, enough + SLACK
     )
     return lower - SLACK, upper
 
