@@ -259,7 +259,11 @@ def grown(array: np.ndarray, size: int) -> np.ndarray:  # pragma: no cover (comp
     if len(array) >= size:
         return array
     bigger = np.empty((max(size, 2 * len(array)), *array.shape[1:]), dtype=array.dtype)
-    bigger[: len(array)] = array
+    # (value by value: ``bigger[: len(array)] = array`` compiles numba's shape-mismatch message
+    # along, a second per kind of array, and the layers grow seven kinds)
+    into = bigger.reshape(-1)
+    for i, value in enumerate(array.flat):
+        into[i] = value
     return bigger
 
 
