@@ -14,7 +14,7 @@ from ompl_balance.bench import first_compile
 SLOW_MODULE = """
 import os, pathlib, time
 began = time.time()
-time.sleep(1.0)
+time.sleep(SECONDS)
 pathlib.Path(os.environ["IMPORTS"], __name__).write_text(f"{began} {time.time()}")
 print("Info: what OMPL prints on standard output")
 """
@@ -24,8 +24,8 @@ print("Info: what OMPL prints on standard output")
 def slow_modules(tmp_path, monkeypatch):
     modules = tmp_path / "modules"
     modules.mkdir()
-    for name in ("slow_one", "slow_two"):
-        (modules / f"{name}.py").write_text(SLOW_MODULE)
+    for name, seconds in (("slow_one", 1.0), ("slow_two", 1.0), ("short", 0.3), ("long", 4.0)):
+        (modules / f"{name}.py").write_text(SLOW_MODULE.replace("SECONDS", str(seconds)))
     (tmp_path / "imports").mkdir()
     monkeypatch.setenv("PYTHONPATH", str(modules))
     monkeypatch.setenv("IMPORTS", str(tmp_path / "imports"))
@@ -50,3 +50,14 @@ def test_modules_are_imported_at_once_in_processes_of_their_own_then_never_again
 def test_a_single_module_is_left_to_the_forkserver(slow_modules):
     first_compile.compile_in_parallel(["__main__", "slow_one"])
     assert list(slow_modules.iterdir()) == []
+
+
+def test_the_last_modules_start_first_and_the_next_as_soon_as_any_ends(slow_modules):
+    # the forkserver's order: the runner's module, then the problem kinds' (which compile longest)
+    first_compile.compile_in_parallel(["__main__", "slow_one", "short", "long"])
+    spans = {
+        name: tuple(map(float, (slow_modules / name).read_text().split())) for name in ("slow_one", "long", "short")
+    }
+    assert spans["long"][0] < spans["slow_one"][0] and spans["short"][0] < spans["slow_one"][0]
+    # slow_one takes the core short leaves, while long (started first) still runs
+    assert spans["short"][1] <= spans["slow_one"][0] < spans["long"][1]

@@ -15,7 +15,11 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
+
+#: Seconds between looks at the compiling processes.
+_POLL = 0.1
 
 
 def _done_marker(module: str) -> Path:
@@ -32,20 +36,31 @@ def compile_in_parallel(modules: list[str]) -> None:
     up to the machine's core count at once, and wait for them (their compile notices go to
     standard error, their standard output nowhere). Nothing is done for fewer than two: the
     forkserver compiles one as fast. A process that fails is left to the forkserver, which
-    compiles and reports the same."""
-    pending = [module for module in modules if module != "__main__" and not _done_marker(module).exists()]
+    compiles and reports the same.
+
+    The modules start last first, the next as soon as any running one ends: the forkserver
+    imports the runner's own module first and those of the problem kinds after it, and theirs
+    compile the longest (their collision kernels, then their engines, which compile the
+    planning loop's kernels every engine shares), so the runner's module, started once one of
+    them is done, finds the shared kernels in numba's cache rather than compiling them alongside.
+    """
+    pending = [module for module in reversed(modules) if module != "__main__" and not _done_marker(module).exists()]
     if len(pending) < 2:
         return
     environment = {**os.environ, "PYTHONSAFEPATH": "1"}  # the installed package (see isolation._context)
     running: list[tuple[str, subprocess.Popen[bytes]]] = []
-    for module in pending:
-        if len(running) >= (os.cpu_count() or 1):
-            _finish(*running.pop(0))
-        # (standard output: OMPL's Info lines, which must not reach the tables on the caller's)
-        command = [sys.executable, "-c", f"import {module}"]
-        running.append((module, subprocess.Popen(command, env=environment, stdout=subprocess.DEVNULL)))
-    for module, process in running:
-        _finish(module, process)
+    while pending or running:
+        while pending and len(running) < (os.cpu_count() or 1):
+            module = pending.pop(0)
+            # (standard output: OMPL's Info lines, which must not reach the tables on the caller's)
+            command = [sys.executable, "-c", f"import {module}"]
+            running.append((module, subprocess.Popen(command, env=environment, stdout=subprocess.DEVNULL)))
+        ended = [(module, process) for module, process in running if process.poll() is not None]
+        for module, process in ended:
+            running.remove((module, process))
+            _finish(module, process)
+        if not ended:
+            time.sleep(_POLL)
 
 
 def _finish(module: str, process: subprocess.Popen[bytes]) -> None:
