@@ -52,9 +52,8 @@ def test_a_single_module_is_left_to_the_forkserver(slow_modules):
     assert list(slow_modules.iterdir()) == []
 
 
-def test_the_last_modules_start_first_and_the_next_as_soon_as_any_ends(slow_modules):
-    # the forkserver's order: the runner's module, then the problem kinds' (which compile longest)
-    first_compile.compile_in_parallel(["__main__", "slow_one", "short", "long"])
+def test_modules_start_in_order_and_the_next_as_soon_as_any_ends(slow_modules):
+    first_compile.compile_in_parallel(["__main__", "long", "short", "slow_one"])
     spans = {
         name: tuple(map(float, (slow_modules / name).read_text().split())) for name in ("slow_one", "long", "short")
     }

@@ -38,13 +38,12 @@ def compile_in_parallel(modules: list[str]) -> None:
     forkserver compiles one as fast. A process that fails is left to the forkserver, which
     compiles and reports the same.
 
-    The modules start last first, the next as soon as any running one ends: the forkserver
-    imports the runner's own module first and those of the problem kinds after it, and theirs
-    compile the longest (their collision kernels, then their engines, which compile the
-    planning loop's kernels every engine shares), so the runner's module, started once one of
-    them is done, finds the shared kernels in numba's cache rather than compiling them alongside.
+    The modules start in the order given, the next as soon as any running one ends: the
+    forkserver imports the runner's own module first, whose engine compiles the planning loop's
+    kernels that every engine shares, so the problem kinds' engines, compiled after their
+    collision kernels, find them in numba's cache rather than compiling them alongside.
     """
-    pending = [module for module in reversed(modules) if module != "__main__" and not _done_marker(module).exists()]
+    pending = [module for module in modules if module != "__main__" and not _done_marker(module).exists()]
     if len(pending) < 2:
         return
     environment = {**os.environ, "PYTHONSAFEPATH": "1"}  # the installed package (see isolation._context)
