@@ -31,11 +31,13 @@ Stock with a plain callable runs on a ``SimpleSetup`` no planner of the package 
 as a user runs it (the package wraps a checker to count its work at setup). Printed per cell:
 success, median time, median checks (the validity function's calls: counted in the function
 for a callable, by the checker for the others), the ratio of medians to stock with the same
-checker and to stock with the plain callable, and the path the package's checks took
-(``engine``, ``checks``, calls out of compiled code per solve). ``--profile`` prints where a
-Balanced solve's time goes with the plain callable (cProfile).
+checker and to stock with the plain callable, the median of each run's time per check, and
+the path the package's checks took (``engine``, ``checks``, calls out of compiled code per
+solve). ``--profile`` prints where a Balanced solve's time goes with the plain callable
+(cProfile); ``--exits`` only times a call out of the compiled loop with a plain callable, by
+the states it carries, against stock's call from C++ per state, and a solve's fixed cost.
 
-    python benchmarks/bench_checkers.py [--runs 30] [--worlds trap,slalom,comb,arm7] [--profile]
+    python benchmarks/bench_checkers.py [--runs 30] [--worlds trap,slalom,comb,arm7] [--profile] [--exits]
 """
 
 from __future__ import annotations
@@ -272,8 +274,8 @@ def table(world: World, checkers: list[str], runs: int) -> None:
     stock_callable = median(results[("callable", "stock")], "time") if "callable" in checkers else math.nan
     print(f"\n### {world.name} ({world.dim}-D), {runs} runs each\n")
     print("| checker | planner | solved | median time (ms) | median checks | time / stock, same checker |", end="")
-    print(" time / stock with the callable | path (exits per solve) |")
-    print("|---|---|---|---|---|---|---|---|")
+    print(" time / stock with the callable | us per check | path (exits per solve) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for checker in checkers:
         stock_time = median(results[(checker, "stock")], "time")
         for planner in PLANNERS:
@@ -283,9 +285,10 @@ def table(world: World, checkers: list[str], runs: int) -> None:
             path = "C++" if planner == "stock" else f"{rows[0]['path']} ({median(rows, 'exits'):.0f})"
             same = "" if planner == "stock" else f"{t / stock_time:.2f}"
             callable_ratio = "" if (planner, checker) == ("stock", "callable") else f"{t / stock_callable:.2f}"
+            per_check = statistics.median(row["time"] / max(row["checks"], 1) for row in rows)
             print(
                 f"| {checker} | {planner} | {solved:.0%} | {t * 1e3:.2f} | {median(rows, 'checks'):.0f} | {same} |"
-                f" {callable_ratio} | {path} |"
+                f" {callable_ratio} | {per_check * 1e6:.2f} | {path} |"
             )
 
 
@@ -306,18 +309,135 @@ def profile(world: World) -> None:
     stats.sort_stats("tottime").print_stats(12)
 
 
+def exit_costs() -> None:
+    """What a call out of the compiled loop costs with a plain callable: the package's exit
+    (:mod:`ompl_balance.core.checks`) asked about ``count`` 2-D states from a compiled loop, each
+    written into the scratch OMPL state and checked by a trivial function, against stock's call
+    from C++ per state (``si.checkMotion`` over a long motion, the same function)."""
+    from ompl_balance.core.checks import EXIT_ADDRESS, exit_handle
+    from ompl_balance.core.function_pointers import call_exit
+    from ompl_balance.engine.views import SpaceChecks
+
+    @numba.njit
+    def ask(calls: int, address: int, handle: int, count: int) -> int:
+        answered = 0
+        for _ in range(calls):
+            answered += call_exit(address, handle, 0, count)
+        return answered
+
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    si = ob.SpaceInformation(space)
+
+    def free(state: ob.State) -> bool:
+        return state[0] < 2.0
+
+    counted = Counted(free)  # (as the benchmark's worlds: the same function both ways)
+    si.setStateValidityChecker(counted)
+    si.setStateValidityCheckingResolution(0.0005)
+    si.setup()
+    target = SpaceChecks(si, counted)
+    target.take_rows(np.random.default_rng(0).random((64, 2)))
+    handle = exit_handle(target)
+    print("\n### A call out of compiled code (2-D, a trivial check; best of 5)\n")
+    print("| states per call | us per call | us per state |\n|---|---|---|")
+    for count in (1, 4, 8, 32):
+        ask(10, EXIT_ADDRESS, handle, count)
+        calls, best = 100_000 // count, math.inf
+        for _ in range(5):
+            began = time.perf_counter()
+            ask(calls, EXIT_ADDRESS, handle, count)
+            best = min(best, (time.perf_counter() - began) / calls)
+        print(f"| {count} | {best * 1e6:.2f} | {best / count * 1e6:.3f} |")
+    a, b = si.allocState(), si.allocState()
+    a[0], a[1], b[0], b[1] = 0.0, 0.0, 1.0, 1.0
+    best = math.inf
+    for _ in range(5):
+        before, began = counted.calls, time.perf_counter()
+        for _ in range(50):
+            si.checkMotion(a, b)
+        best = min(best, (time.perf_counter() - began) / (counted.calls - before))
+    print(f"\nstock, OMPL's checkMotion calling the function from C++: {best * 1e6:.3f} us per state")
+    best = math.inf
+    state = si.allocState()
+    for _ in range(5):
+        began = time.perf_counter()
+        for _ in range(100_000):
+            counted(state)
+        best = min(best, (time.perf_counter() - began) / 100_000)
+    print(f"the function alone, called from Python: {best * 1e6:.3f} us")
+
+
+def fixed_costs(solves: int = 300) -> None:
+    """A solve's fixed cost: ``ss.solve`` of a 2-D problem in free space whose goal is within one
+    step of its start (one iteration, two motions checked), stock and Balanced, with a trivial
+    plain callable and with the same test in numba; the planner cleared before each solve
+    (untimed), medians of ``solves``."""
+
+    def free(state: ob.State) -> bool:
+        return True
+
+    @numba.njit
+    def free_q(q: np.ndarray) -> bool:
+        return True
+
+    print(f"\n### A solve's fixed cost (2-D, goal one step from the start; medians of {solves} solves)\n")
+    print("| checker | stock (us) | Balanced (us) | checks per solve |\n|---|---|---|---|")
+    for checker in ("callable", "numba"):
+        times: dict[str, list[float]] = {}
+        checks = 0
+        for planner in PLANNERS:
+            space = ob.RealVectorStateSpace(2)
+            space.setBounds(0.0, 1.0)
+            ss = og.SimpleSetup(space)
+            counted = Counted(free)
+            if checker == "callable":
+                ss.setStateValidityChecker(counted)
+            else:
+                setup_checker(ss, free_q)
+            start, goal = space.allocState(), space.allocState()
+            start[0], start[1], goal[0], goal[1] = 0.40, 0.40, 0.45, 0.45
+            ss.setStartAndGoalStates(start, goal)
+            si = ss.getSpaceInformation()
+            made = og.RRTConnect(si) if planner == "stock" else BalancedRRTConnect(si)
+            ss.setPlanner(made)
+            ss.setup()
+            if planner == "balanced":
+                made.wait_for_engine()
+            spent = times.setdefault(planner, [])
+            for index in range(solves + 10):
+                made.clear()
+                ss.getProblemDefinition().clearSolutionPaths()
+                ptc = ob.timedPlannerTerminationCondition(10.0)
+                before, began = counted.calls, time.perf_counter()
+                ss.solve(ptc)
+                if index >= 10:  # (the first solves warm the caches)
+                    spent.append(time.perf_counter() - began)
+            checks = counted.calls - before
+        stock, balanced = (statistics.median(times[planner]) * 1e6 for planner in PLANNERS)
+        shown = f"{checks}" if checker == "callable" else "(in compiled code)"
+        print(f"| {checker} | {stock:.0f} | {balanced:.0f} | {shown} |")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=30, help="runs per planner and checker (default 30)")
     parser.add_argument("--worlds", default="trap,slalom,comb,arm7", help="comma-separated: trap, slalom, comb, arm7")
     parser.add_argument("--checkers", default="callable,numba,vectorized", help="comma-separated")
     parser.add_argument("--profile", action="store_true", help="profile a Balanced solve with the callable")
+    parser.add_argument(
+        "--exits", action="store_true", help="only time a call out of compiled code and a solve's fixed cost"
+    )
     args = parser.parse_args()
     ou.setLogLevel(ou.LOG_WARN)
     available = worlds()
     chosen = [available[name] for name in args.worlds.split(",")]
     checkers = args.checkers.split(",")
     print(f"# bench_checkers: {time.strftime('%Y-%m-%d')}, numba {numba.__version__}")
+    if args.exits:
+        exit_costs()
+        fixed_costs()
+        return
     for world in chosen:
         table(world, checkers, args.runs)
         if args.profile:

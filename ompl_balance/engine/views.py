@@ -61,11 +61,13 @@ class SpaceChecks:
         if kind == _STATES:
             state, is_valid = self._scratch[0], self._is_valid
             for first, last in self._chunks[count]:
-                for index, values in enumerate(rows[first:last].tolist(), first):
+                index = first  # (counted by hand: enumerate costs a tenth of a microsecond per exit)
+                for values in rows[first:last].tolist():
                     copy(state, values)
                     valid = is_valid(state)
                     if valid is not True and (valid is False or not validity(valid, is_valid)):
                         return index
+                    index += 1
             return count
         start, end = self._scratch
         copy(start, rows[0].tolist())
