@@ -314,7 +314,7 @@ def test_the_live_command_ends_cleanly_on_ctrl_c():
         "0",
         "--no-browser",
     ]  # (stock: nothing to compile)
-    command = [sys.executable, "-m", "ompl_balance.cli", *arguments]
+    command = [sys.executable, "-X", "faulthandler", "-m", "ompl_balance.cli", *arguments]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         address = None
@@ -327,10 +327,40 @@ def test_the_live_command_ends_cleanly_on_ctrl_c():
         with urllib.request.urlopen(address, timeout=10) as answer:
             assert answer.status == 200
         process.send_signal(signal.SIGINT)
-        out, _ = process.communicate(timeout=30)
+        try:
+            out, _ = process.communicate(timeout=60)
+        except subprocess.TimeoutExpired:  # (where it stands: every thread's stack, by faulthandler)
+            process.send_signal(signal.SIGABRT)
+            out, _ = process.communicate(timeout=30)
+            pytest.fail(f"the viewer did not stop within 60 s of Ctrl-C:\n{out}")
     finally:
         if process.poll() is None:
             process.kill()
             process.wait()
     assert process.returncode == 0, out
     assert "viewer stopped" in out and "Traceback" not in out
+
+
+@pytest.mark.parametrize("command", [True, False])
+def test_ctrl_c_as_soon_as_the_viewer_is_up_stops_it(command, monkeypatch, capsys):
+    """A Ctrl-C between the viewer starting and its wait for Ctrl-C (here: while the browser is
+    being opened) stops the viewer's server, whose threads would otherwise keep the process alive
+    after the command or script ends: the command ends as on any Ctrl-C, ``show`` raises it."""
+    import threading
+    import webbrowser
+
+    def interrupted(url):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(webbrowser, "open", interrupted)
+    before = set(threading.enumerate())
+    if command:
+        assert main(["show", "maze", "--planner", "RRTConnect", "--port", "0"]) == 0
+        assert "viewer stopped" in capsys.readouterr().out
+    else:
+        with pytest.raises(KeyboardInterrupt):
+            show(named_problem("maze").setup(), port=0)
+    left = [thread for thread in set(threading.enumerate()) - before if not thread.daemon]
+    for thread in left:
+        thread.join(timeout=10.0)
+    assert not [thread for thread in left if thread.is_alive()]

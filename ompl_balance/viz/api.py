@@ -87,13 +87,17 @@ def show(
     if file is not None:
         return write_page(scene, plan, frames, file, trees).path
     viewer = LiveViewer(scene, plan, frames, trees, host, port)
-    if open_browser:
-        import webbrowser
+    try:
+        if open_browser:
+            import webbrowser
 
-        webbrowser.open(viewer.url)
-    if wait:
-        print(f"showing {scene.title} at {viewer.url} (Ctrl-C to stop)")
-        viewer.wait()
+            webbrowser.open(viewer.url)
+        if wait:
+            print(f"showing {scene.title} at {viewer.url} (Ctrl-C to stop)")
+            viewer.wait()
+    except BaseException:  # (Ctrl-C included: the server's threads would keep the process alive)
+        viewer.stop()
+        raise
     return viewer
 
 

@@ -121,11 +121,16 @@ def run_show(
         print(f"wrote {page.path} ({size / 1e6:.1f} MB, {time.perf_counter() - began:.1f} s): open it in a browser")
     else:
         viewer = LiveViewer(scene, plan, planned.frames, trees, host, port)
-        print(f"showing {scene.title} at {viewer.url} (Ctrl-C to stop)", flush=True)
-        if open_browser:
-            import webbrowser
+        try:  # (Ctrl-C from the moment the address is out stops the viewer: its server's threads would live on)
+            print(f"showing {scene.title} at {viewer.url} (Ctrl-C to stop)", flush=True)
+            if open_browser:
+                import webbrowser
 
-            webbrowser.open(viewer.url)
-        viewer.wait()
+                webbrowser.open(viewer.url)
+            viewer.wait()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            viewer.stop()
         print("viewer stopped")
     return 0 if planned.solved else 1

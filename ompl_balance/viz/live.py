@@ -56,35 +56,40 @@ class LiveViewer:
 
         with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller prints the address
             self.server = viser.ViserServer(host=host, port=port, verbose=False)
-        self.host = host
-        self.port = int(self.server.get_port())
-        self.scene, self.plan = scene, plan
-        self.drawing = Drawing(self.server, scene, plan, frames, trees)
-        self._lock = threading.Lock()
-        self._playing = threading.Event()
-        self._stopped = threading.Event()
-        gui = self.server.gui
-        # the panel beside the view, not over it; no share button (it would open a public tunnel)
-        gui.configure_theme(show_share_button=False)
-        gui.main_panel.dock_right()
-        gui.add_markdown(self._summary())
-        count = max(len(frames), 1)
-        self._slider = gui.add_slider("frame", min=0, max=count - 1, step=1, initial_value=0, disabled=count < 2)
-        self._play = gui.add_button("play", disabled=count < 2)
-        self._readout = gui.add_markdown(self._closest(0))
-        self._slider.on_update(lambda _event: self._show(int(self._slider.value)))
-        self._play.on_click(lambda _event: self._toggle())
-        ends = gui.add_checkbox("start and goal", True)
-        ends.on_update(lambda _event: self._locked(self.drawing.show_ends, ends.value))
-        for label, prefix in (("path", "/path"), ("trees", "/trees")):
-            if self.drawing.nodes(prefix):
-                box = gui.add_checkbox(label, True)
-                box.on_update(lambda _event, box=box, prefix=prefix: self._layer(prefix, box.value))
-        if scene.visuals:
-            visual = gui.add_checkbox("visual meshes (else collision geometry)", True)
-            visual.on_update(lambda _event: self._visuals(visual.value))
-        self._thread = threading.Thread(target=self._animate, name="ompl-balance viewer", daemon=True)
-        self._thread.start()
+        try:  # (the server runs threads that keep the process alive: stopped if the rest fails, Ctrl-C too)
+            self.host = host
+            self.port = int(self.server.get_port())
+            self.scene, self.plan = scene, plan
+            self.drawing = Drawing(self.server, scene, plan, frames, trees)
+            self._lock = threading.Lock()
+            self._playing = threading.Event()
+            self._stopped = threading.Event()
+            gui = self.server.gui
+            # the panel beside the view, not over it; no share button (it would open a public tunnel)
+            gui.configure_theme(show_share_button=False)
+            gui.main_panel.dock_right()
+            gui.add_markdown(self._summary())
+            count = max(len(frames), 1)
+            self._slider = gui.add_slider("frame", min=0, max=count - 1, step=1, initial_value=0, disabled=count < 2)
+            self._play = gui.add_button("play", disabled=count < 2)
+            self._readout = gui.add_markdown(self._closest(0))
+            self._slider.on_update(lambda _event: self._show(int(self._slider.value)))
+            self._play.on_click(lambda _event: self._toggle())
+            ends = gui.add_checkbox("start and goal", True)
+            ends.on_update(lambda _event: self._locked(self.drawing.show_ends, ends.value))
+            for label, prefix in (("path", "/path"), ("trees", "/trees")):
+                if self.drawing.nodes(prefix):
+                    box = gui.add_checkbox(label, True)
+                    box.on_update(lambda _event, box=box, prefix=prefix: self._layer(prefix, box.value))
+            if scene.visuals:
+                visual = gui.add_checkbox("visual meshes (else collision geometry)", True)
+                visual.on_update(lambda _event: self._visuals(visual.value))
+            self._thread = threading.Thread(target=self._animate, name="ompl-balance viewer", daemon=True)
+            self._thread.start()
+        except BaseException:
+            with contextlib.redirect_stdout(io.StringIO()):
+                self.server.stop()
+            raise
 
     @property
     def url(self) -> str:
