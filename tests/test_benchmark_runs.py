@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
+from fresh_process import with_ctrl_c_as_in_a_terminal
 from ompl import base as ob
 from ompl import geometric as og
 from test_benchmark import deterministic
@@ -248,19 +249,11 @@ def _console_script() -> str:
     return str(Path(sys.executable).with_name("ompl-balance"))
 
 
-def _with_ctrl_c_as_in_a_terminal(command: list[str]) -> list[str]:
-    """``command``, started with SIGINT's default action, as a terminal's foreground job has it
-    (a test suite run as a background job passes "ignore" on, and Python then never raises
-    KeyboardInterrupt): a Python stub resets it and replaces itself with ``command``."""
-    stub = "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); os.execv(sys.argv[1], sys.argv[1:])"
-    return [sys.executable, "-c", stub, *command]
-
-
 def test_compare_interrupted_then_run_again_resumes(tmp_path):
     out = tmp_path / "out"
     command = [_console_script(), "compare", "--problems", "open", "--runs", "20", "-o", str(out), "--no-progress"]
     compare = subprocess.Popen(
-        _with_ctrl_c_as_in_a_terminal(command),
+        with_ctrl_c_as_in_a_terminal(command),
         start_new_session=True,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,

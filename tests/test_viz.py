@@ -11,6 +11,7 @@ import urllib.request
 import numpy as np
 import pytest
 import trimesh
+from fresh_process import with_ctrl_c_as_in_a_terminal
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -314,7 +315,7 @@ def test_the_live_command_ends_cleanly_on_ctrl_c():
         "0",
         "--no-browser",
     ]  # (stock: nothing to compile)
-    command = [sys.executable, "-X", "faulthandler", "-m", "ompl_balance.cli", *arguments]
+    command = with_ctrl_c_as_in_a_terminal([sys.executable, "-X", "faulthandler", "-m", "ompl_balance.cli", *arguments])
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         address = None
