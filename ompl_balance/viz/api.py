@@ -95,7 +95,7 @@ def show(
         if wait:
             print(f"showing {scene.title} at {viewer.url} (Ctrl-C to stop)")
             viewer.wait()
-    except BaseException:  # (Ctrl-C included: the server's threads would keep the process alive)
+    except BaseException:  # (a Ctrl-C before or during the wait too: the server stops either way)
         viewer.stop()
         raise
     return viewer

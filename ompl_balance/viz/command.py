@@ -121,7 +121,7 @@ def run_show(
         print(f"wrote {page.path} ({size / 1e6:.1f} MB, {time.perf_counter() - began:.1f} s): open it in a browser")
     else:
         viewer = LiveViewer(scene, plan, planned.frames, trees, host, port)
-        try:  # (Ctrl-C from the moment the address is out stops the viewer: its server's threads would live on)
+        try:  # (a Ctrl-C from the moment the address is out stops the viewer, before the wait as in it)
             print(f"showing {scene.title} at {viewer.url} (Ctrl-C to stop)", flush=True)
             if open_browser:
                 import webbrowser

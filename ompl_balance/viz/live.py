@@ -56,7 +56,7 @@ class LiveViewer:
 
         with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the caller prints the address
             self.server = viser.ViserServer(host=host, port=port, verbose=False)
-        try:  # (the server runs threads that keep the process alive: stopped if the rest fails, Ctrl-C too)
+        try:  # (the server is running: stopped if the rest fails, a Ctrl-C included)
             self.host = host
             self.port = int(self.server.get_port())
             self.scene, self.plan = scene, plan
