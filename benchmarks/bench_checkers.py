@@ -309,6 +309,16 @@ def profile(world: World) -> None:
     stats.sort_stats("tottime").print_stats(12)
 
 
+def best_of_five(run: Callable[[], int]) -> float:
+    """The least seconds per unit of work over five calls of ``run`` (which returns its units)."""
+    best = math.inf
+    for _ in range(5):
+        began = time.perf_counter()
+        units = run()
+        best = min(best, (time.perf_counter() - began) / units)
+    return best
+
+
 def exit_costs() -> None:
     """What a call out of the compiled loop costs with a plain callable: the package's exit
     (:mod:`ompl_balance.core.checks`) asked about ``count`` 2-D states from a compiled loop, each
@@ -319,11 +329,10 @@ def exit_costs() -> None:
     from ompl_balance.engine.views import SpaceChecks
 
     @numba.njit
-    def ask(calls: int, address: int, handle: int, count: int) -> int:
-        answered = 0
+    def ask(calls: int, address: int, handle: int, count: int) -> int:  # (returns the calls made)
         for _ in range(calls):
-            answered += call_exit(address, handle, 0, count)
-        return answered
+            call_exit(address, handle, 0, count)
+        return calls
 
     space = ob.RealVectorStateSpace(2)
     space.setBounds(0.0, 1.0)
@@ -343,28 +352,27 @@ def exit_costs() -> None:
     print("| states per call | us per call | us per state |\n|---|---|---|")
     for count in (1, 4, 8, 32):
         ask(10, EXIT_ADDRESS, handle, count)
-        calls, best = 100_000 // count, math.inf
-        for _ in range(5):
-            began = time.perf_counter()
-            ask(calls, EXIT_ADDRESS, handle, count)
-            best = min(best, (time.perf_counter() - began) / calls)
+        calls = 100_000 // count
+        best = best_of_five(lambda calls=calls, count=count: ask(calls, EXIT_ADDRESS, handle, count))
         print(f"| {count} | {best * 1e6:.2f} | {best / count * 1e6:.3f} |")
     a, b = si.allocState(), si.allocState()
     a[0], a[1], b[0], b[1] = 0.0, 0.0, 1.0, 1.0
-    best = math.inf
-    for _ in range(5):
-        before, began = counted.calls, time.perf_counter()
+
+    def motions() -> int:
+        before = counted.calls
         for _ in range(50):
             si.checkMotion(a, b)
-        best = min(best, (time.perf_counter() - began) / (counted.calls - before))
-    print(f"\nstock, OMPL's checkMotion calling the function from C++: {best * 1e6:.3f} us per state")
-    best = math.inf
+        return counted.calls - before
+
+    print(f"\nstock, OMPL's checkMotion calling the function from C++: {best_of_five(motions) * 1e6:.3f} us per state")
     state = si.allocState()
-    for _ in range(5):
-        began = time.perf_counter()
+
+    def alone() -> int:
         for _ in range(100_000):
             counted(state)
-        best = min(best, (time.perf_counter() - began) / 100_000)
+        return 100_000
+
+    best = best_of_five(alone)
     print(f"the function alone, called from Python: {best * 1e6:.3f} us")
 
 
@@ -381,23 +389,15 @@ def fixed_costs(solves: int = 300) -> None:
     def free_q(q: np.ndarray) -> bool:
         return True
 
+    # (no vectorized form: not timed)
+    world = World("free", 2, 0.0, 1.0, (0.40, 0.40), (0.45, 0.45), free, free_q, lambda q: np.ones(len(q), bool), 10.0)
     print(f"\n### A solve's fixed cost (2-D, goal one step from the start; medians of {solves} solves)\n")
     print("| checker | stock (us) | Balanced (us) | checks per solve |\n|---|---|---|---|")
     for checker in ("callable", "numba"):
         times: dict[str, list[float]] = {}
         checks = 0
         for planner in PLANNERS:
-            space = ob.RealVectorStateSpace(2)
-            space.setBounds(0.0, 1.0)
-            ss = og.SimpleSetup(space)
-            counted = Counted(free)
-            if checker == "callable":
-                ss.setStateValidityChecker(counted)
-            else:
-                setup_checker(ss, free_q)
-            start, goal = space.allocState(), space.allocState()
-            start[0], start[1], goal[0], goal[1] = 0.40, 0.40, 0.45, 0.45
-            ss.setStartAndGoalStates(start, goal)
+            ss, counted = simple_setup(world, checker)
             si = ss.getSpaceInformation()
             made = og.RRTConnect(si) if planner == "stock" else BalancedRRTConnect(si)
             ss.setPlanner(made)
@@ -409,11 +409,11 @@ def fixed_costs(solves: int = 300) -> None:
                 made.clear()
                 ss.getProblemDefinition().clearSolutionPaths()
                 ptc = ob.timedPlannerTerminationCondition(10.0)
-                before, began = counted.calls, time.perf_counter()
+                before, began = (counted.calls if counted else 0), time.perf_counter()
                 ss.solve(ptc)
                 if index >= 10:  # (the first solves warm the caches)
                     spent.append(time.perf_counter() - began)
-            checks = counted.calls - before
+            checks = counted.calls - before if counted else 0
         stock, balanced = (statistics.median(times[planner]) * 1e6 for planner in PLANNERS)
         shown = f"{checks}" if checker == "callable" else "(in compiled code)"
         print(f"| {checker} | {stock:.0f} | {balanced:.0f} | {shown} |")
