@@ -447,6 +447,63 @@ def test_clear_then_solve_again():
     assert first_sizes > 0
 
 
+@pytest.mark.parametrize("planner_class", [BalancedRRTConnect, BallRadiusRRTstar])
+def test_setup_and_clear_called_from_python_run_once_as_from_simple_setup(planner_class):
+    # OMPL's bindings send the base's call in a super().setup() made from Python back to the most
+    # derived override: each override in the chain (a user's subclass too) would run twice
+    calls = []
+
+    class Counted(planner_class):
+        def setup(self):
+            super().setup()
+            calls.append("setup")
+
+        def clear(self):
+            super().clear()
+            calls.append("clear")
+
+    problem = get_problem("maze")
+    ss = problem.setup()
+    planner = Counted(ss.getSpaceInformation())
+    planner.setSeed(3)
+    ss.setPlanner(planner)
+    planner.setup()
+    planner.clear()
+    ss.clear()
+    assert calls == ["setup", "clear", "clear"]
+    # OMPL's own clear() ran too: the planner input states restart, the start tree is rooted again
+    assert ss.solve(2.0)
+    assert planner.plannerData().numVertices() > 0
+
+
+CLEARED_RUN = """
+import sys
+from ompl import util as ou
+ou.RNG.setSeed(int(sys.argv[1]))
+ou.setLogLevel(ou.LOG_NONE)
+from ompl_balance import BalancedRRTConnect
+from ompl_balance.worlds.boxes import get_problem
+ss = get_problem("maze").setup()
+planner = BalancedRRTConnect(ss.getSpaceInformation())
+ss.setPlanner(planner)
+{owner}.setup()
+ss.solve(10.0)
+{owner}.clear()
+ss.getProblemDefinition().clearSolutionPaths()  # (as ss.clear() does)
+ss.solve(10.0)
+path = ss.getSolutionPath()
+print([round(path.getState(i)[j], 12) for i in range(path.getStateCount()) for j in range(2)])
+"""
+
+
+def test_setup_and_clear_from_python_draw_the_seeds_simple_setups_do():
+    # with seed = 0 each setup and clear draws the next solve's seed from the planner's OMPL RNG:
+    # one draw whoever calls them, so the same global seed gives the same paths
+    by_simple_setup = run_with_seed(CLEARED_RUN.format(owner="ss"), 11)
+    by_python = run_with_seed(CLEARED_RUN.format(owner="planner"), 11)
+    assert by_simple_setup.startswith("[") and by_python == by_simple_setup
+
+
 def test_stats_count_the_work_of_one_solve():
     _problem, ss, planner, _status = solve_problem("narrow_gap")
     stats = planner.stats

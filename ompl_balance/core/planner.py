@@ -7,7 +7,9 @@ statistics record (``Stats``), what it is (``SPECS``) and its search
 
 * ``params()`` and the camelCase accessors, from the settings table;
 * ``setup()``: the counting checker (:func:`~ompl_balance.core.counting.ensure_counting`);
-  nothing that takes time, since ``SimpleSetup.solve`` calls it inside the solve;
+  nothing that takes time, since ``SimpleSetup.solve`` calls it inside the solve; ``setup()``
+  and ``clear()`` (a subclass's too) run once per call, from Python as from C++
+  (:func:`_once_per_call`);
 * ``solve(ptc)``: the termination condition from what it was given (a condition, seconds
   or a callable), the seed of the solve (the ``seed`` parameter, or a draw from the planner's
   OMPL ``RNG``, which ``ompl.util.RNG.setSeed`` repeats), the work counted, and ``stats``;
@@ -22,6 +24,7 @@ lists those limits and how the package works around them.
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 import time
@@ -142,6 +145,33 @@ class _ForPythonCallers:
         return getattr(ob.Planner, self.name).__get__(planner, owner)
 
 
+#: The ``ob.Planner`` methods the package's planners extend (``super().setup()`` first, then theirs).
+EXTENDED_METHODS = ("setup", "clear")
+
+
+def _once_per_call(method: Callable[..., Any]) -> Callable[..., Any]:
+    """A planner's ``setup`` or ``clear`` that runs once per call, called from Python as from C++.
+
+    OMPL 2.0.1's bindings (nanobind) tell a call of ``ob.Planner.setup(self)`` made inside a
+    Python override apart from a new call only when C++ made the outer call (``SimpleSetup``).
+    Called from Python (``planner.setup()``, ``planner.clear()``), the base's call is sent back to
+    the most derived override first, which would run every override in the chain twice (twice
+    the cost, and a second seed drawn from the planner's RNG). :meth:`TreePlanner._call_base`
+    marks the planner while OMPL's own method runs; an override called back meanwhile hands the
+    call straight to OMPL's.
+    """
+    base = getattr(ob.Planner, method.__name__)
+
+    @functools.wraps(method)
+    def extended(planner: Any, *args: Any) -> Any:
+        if planner.__dict__.get("_in_base_call", False):
+            return base(planner, *args)  # the base's call sent back: now nanobind runs OMPL's own
+        return method(planner, *args)
+
+    extended.__once_per_call__ = True  # type: ignore[attr-defined]
+    return extended
+
+
 @dataclass
 class Progress:
     """What a solve has done so far, updated as it runs (read by :meth:`TreePlanner.progressProperties`)."""
@@ -170,6 +200,10 @@ class TreePlanner(ob.Planner):
         super().__init_subclass__(**kwargs)
         if "Settings" in cls.__dict__:
             add_accessors(cls, cls.Settings)
+        for name in EXTENDED_METHODS:  # (a user's subclass too)
+            method = cls.__dict__.get(name)
+            if method is not None and not getattr(method, "__once_per_call__", False):
+                setattr(cls, name, _once_per_call(method))
 
     def __init__(self, si: ob.SpaceInformation, name: str | None = None) -> None:
         if name is not None and not isinstance(name, str):
@@ -187,6 +221,7 @@ class TreePlanner(ob.Planner):
         ob.Planner.printProperties(self)
         ob.Planner.printSettings(self)
         self._cpp_overrides_resolved = True
+        self._in_base_call = False  # while OMPL's own setup() or clear() runs (see _once_per_call)
         self.settings: Any = type(self).Settings()
         self._params: ParamSet | None = None  # made at the first params(): a planner constructed is not configured
         self._rng = ou.RNG()  # per-planner stream, seeded from OMPL's global seed
@@ -231,17 +266,28 @@ class TreePlanner(ob.Planner):
         values = "".join(f"{name} = {value}\n" for name, value in self.params().getParams().items())
         return f"Declared parameters for planner {self.getName()}:\n{values}"
 
+    @_once_per_call
     def setup(self) -> None:
-        super().setup()
+        self._call_base(ob.Planner.setup)
         si = self.getSpaceInformation()
         ensure_counting(si)
         self._points = points_for(si)  # how solves see the space (each restarts it with its seed)
         self._prepare_generator()
 
+    @_once_per_call
     def clear(self) -> None:
-        super().clear()
+        self._call_base(ob.Planner.clear)
         self.stats = None
         self._prepare_generator()
+
+    def _call_base(self, method: Callable[[ob.Planner], None]) -> None:
+        """OMPL's own ``method`` (``ob.Planner.setup`` or ``clear``) on this planner, once (see
+        :func:`_once_per_call`)."""
+        self._in_base_call = True
+        try:
+            method(self)
+        finally:
+            self._in_base_call = False
 
     def _prepare_generator(self) -> None:
         """Make the next solve's generator now (at setup and clear, as OMPL's planners allocate:
