@@ -380,7 +380,8 @@ def fixed_costs(solves: int = 300) -> None:
     """A solve's fixed cost: ``ss.solve`` of a 2-D problem in free space whose goal is within one
     step of its start (one iteration, two motions checked), stock and Balanced, with a trivial
     plain callable and with the same test in numba; the planner cleared before each solve
-    (untimed), medians of ``solves``."""
+    (untimed), medians of ``solves``. Then what precedes a solve: a planner constructed and
+    set up (``planner.setup()`` from Python, the problem already set up), and ``planner.clear()``."""
 
     def free(state: ob.State) -> bool:
         return True
@@ -417,6 +418,31 @@ def fixed_costs(solves: int = 300) -> None:
         stock, balanced = (statistics.median(times[planner]) * 1e6 for planner in PLANNERS)
         shown = f"{checks}" if checker == "callable" else "(in compiled code)"
         print(f"| {checker} | {stock:.0f} | {balanced:.0f} | {shown} |")
+    print("\n| before a solve (plain callable) | stock (us) | Balanced (us) | Balanced / stock |\n|---|---|---|---|")
+    ss, _counted = simple_setup(world, "callable")
+    ss.setup()
+    si, pdef = ss.getSpaceInformation(), ss.getProblemDefinition()
+    BalancedRRTConnect(si).wait_for_engine()  # (the engine loaded, as for the solves above)
+    made: dict[str, ob.Planner] = {}
+
+    def construct_and_set_up(planner: str) -> None:
+        made[planner] = og.RRTConnect(si) if planner == "stock" else BalancedRRTConnect(si)
+        made[planner].setProblemDefinition(pdef)
+        made[planner].setup()
+
+    for label, action in (
+        ("construction + setup()", construct_and_set_up),
+        ("clear()", lambda planner: made[planner].clear()),
+    ):
+        spent = {planner: [] for planner in PLANNERS}
+        for index in range(solves + 10):
+            for planner in PLANNERS:
+                began = time.perf_counter()
+                action(planner)
+                if index >= 10:
+                    spent[planner].append(time.perf_counter() - began)
+        stock, balanced = (statistics.median(spent[planner]) * 1e6 for planner in PLANNERS)
+        print(f"| {label} | {stock:.0f} | {balanced:.0f} | {balanced / stock:.1f} |")
 
 
 def main() -> None:

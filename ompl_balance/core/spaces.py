@@ -136,7 +136,7 @@ class ArrayPoints:
 
     def is_finite(self, state: ob.State) -> bool:
         """``False`` when an OMPL state has a NaN or infinite value (bounds checks miss NaN)."""
-        return all(math.isfinite(value) for value in self._read(state))
+        return all(map(math.isfinite, self._read(state)))
 
     def from_state(self, state: ob.State) -> np.ndarray:
         """A copy of an OMPL state's values, ``(dim,)``."""

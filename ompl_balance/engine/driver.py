@@ -72,6 +72,7 @@ class SolveArrays:
         self.failures: list[Any] = []
         self.room = 0
         self._fitted = False  # whether the loop's sizes with room (Slot.START_FITS, GOAL_FITS) are the arrays' own
+        self._fits = [0, 0]  # those sizes (start tree, goal tree), as the loop's ints hold them
         self._settings: tuple[tuple[Any, ...], Any] | None = None  # the last solve's LoopSettings, and their source
 
     def settings_for(self, points: Points, settings: RRTConnectSettings, record: bool) -> Any:
@@ -112,10 +113,7 @@ class SolveArrays:
         move only as they outgrow them), and the planner fits them at setup."""
         start_tree, goal_tree = solve.start_tree, solve.goal_tree
         assert isinstance(start_tree, ArrayTree) and isinstance(goal_tree, ArrayTree)
-        ints = self.loop.ints
-        fits = ints[Slot.START_FITS : Slot.GOAL_FITS + 1].tolist()
-        ints[:] = 0
-        ints[Slot.START_FITS : Slot.GOAL_FITS + 1] = fits
+        self.loop.ints[: Slot.START_FITS] = 0  # (the sizes with room, the last slots, stay)
         self.loop.reals[:] = 0.0
         rows = 4 * room + 64 if record else 0
         if len(self.loop.record) < rows or (rows == 0 and len(self.loop.record)):
@@ -134,14 +132,18 @@ class SolveArrays:
         Within a solve only the loop and the goal states fed add nodes, and neither moves an
         array that has room, so the arrays are looked at again only when a tree outgrows them.
         """
-        sizes = [len(tree) for tree in self._planner_trees]
-        self.loop.sizes[:] = sizes
-        self._make_record_room()
-        fits = self.loop.ints[Slot.START_FITS : Slot.GOAL_FITS + 1]
-        if self._fitted and all(size <= fit for size, fit in zip(sizes, fits)):
+        start, goal = self._planner_trees
+        start_size, goal_size = len(start), len(goal)
+        sizes = self.loop.sizes
+        sizes[0], sizes[1] = start_size, goal_size
+        if len(self.loop.record):
+            self._make_record_room()
+        fits = self._fits
+        if self._fitted and start_size <= fits[0] and goal_size <= fits[1]:
             return
         self._make_tree_room()
-        fits[:] = [_nodes_with_room(tree) - self.room for tree in self.trees]
+        self._fits = [_nodes_with_room(tree) - self.room for tree in self.trees]
+        self.loop.ints[Slot.START_FITS : Slot.GOAL_FITS + 1] = self._fits
         self._fitted = True
 
     def _make_tree_room(self) -> None:
@@ -174,9 +176,9 @@ class SolveArrays:
         self.trees = trees[0], trees[1]
 
     def _make_record_room(self) -> None:
-        """Room in the record (when the loop records) for one more iteration's rows."""
+        """Room in the record (the loop records: it has rows) for one more iteration's rows."""
         record = self.loop.record
-        if len(record) and len(record) - self.loop.ints[Slot.RECORDED] < self.room + 2:
+        if len(record) - self.loop.ints[Slot.RECORDED] < self.room + 2:
             rows = 2 * len(record) + self.room
             self.loop = self.loop._replace(
                 record=_grown(record, rows), record_target=_grown(self.loop.record_target, rows)
@@ -184,8 +186,10 @@ class SolveArrays:
 
     def adopt(self) -> None:
         """The planner's trees take the nodes the loop added."""
-        for t, tree in enumerate(self._planner_trees):
-            tree.adopt(int(self.loop.sizes[t]))
+        start_size, goal_size = self.loop.sizes.tolist()
+        start, goal = self._planner_trees
+        start.adopt(start_size)
+        goal.adopt(goal_size)
 
 
 _RUNNERS: dict[Any, Callable[..., int]] = {}
@@ -220,8 +224,12 @@ def _nothing() -> None:
     """No SIGINT to act on (what :func:`interrupts_between_slices` yields where it leaves SIGINT alone)."""
 
 
-@contextlib.contextmanager
-def interrupts_between_slices(exits: bool) -> Iterator[Callable[[], None]]:
+#: :func:`interrupts_between_slices` of a solve whose kernels never call Python (made once: a solve's
+#: fixed cost counts).
+_HANDLER_KEPT = contextlib.nullcontext(_nothing)
+
+
+def interrupts_between_slices(exits: bool) -> contextlib.AbstractContextManager[Callable[[], None]]:
     """Ctrl-C during a compiled solve, acted on between slices: yields ``check()``, which calls
     the process's SIGINT handler (Python's raises ``KeyboardInterrupt``) if SIGINT came since
     the last call.
@@ -235,8 +243,14 @@ def interrupts_between_slices(exits: bool) -> Iterator[Callable[[], None]]:
     where SIGINT is ignored (a background job) or left to the system (it ends the process).
     """
     if not exits or threading.current_thread() is not threading.main_thread():
-        yield _nothing
-        return
+        return _HANDLER_KEPT
+    return _flag_interrupts()
+
+
+@contextlib.contextmanager
+def _flag_interrupts() -> Iterator[Callable[[], None]]:
+    """SIGINT sets a flag while the solve runs (main thread, a solve whose kernels call Python;
+    see :func:`interrupts_between_slices`)."""
     # (signal's own functions wrap _signal's, turning each handler into an enum: 7 us a solve)
     handler = _signal.getsignal(signal.SIGINT)
     if not callable(handler):
@@ -330,20 +344,20 @@ def run(
 
 def _report(solve: Solve, arrays: loop.Loop, exits: int) -> None:
     """Hand what the compiled loop did to the planner's side: swap state, counts, gap, record."""
-    ints, reals = arrays.ints, arrays.reals
+    ints = arrays.ints.tolist()
     state = solve.swap_state
     state.grew_start, state.steps, state.collided = (
         bool(ints[Slot.GREW_START]),
-        int(ints[Slot.STEPS]),
+        ints[Slot.STEPS],
         bool(ints[Slot.COLLIDED]),
     )
     counts = solve.counts
-    counts.iterations = int(ints[Slot.ITERATIONS])
-    counts.swaps = ints[Slot.SWAPS : Slot.SWAPS + len(SwapCause)].tolist()  # (by cause, in SwapCause order)
+    counts.iterations = ints[Slot.ITERATIONS]
+    counts.swaps = ints[Slot.SWAPS : Slot.SWAPS + len(SwapCause)]  # (by cause, in SwapCause order)
     counts.exits = exits
-    solve.sampler_counts.rejections += int(ints[Slot.REJECTIONS])
+    solve.sampler_counts.rejections += ints[Slot.REJECTIONS]
     solve.progress.iterations = counts.iterations
-    solve.tree_gap = float(reals[Real.TREE_GAP])
+    solve.tree_gap = float(arrays.reals[Real.TREE_GAP])
     if solve.record is not None:
         _fill_record(solve, arrays)
 

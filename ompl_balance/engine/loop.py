@@ -85,7 +85,7 @@ class Slot(enum.IntEnum):
     GOAL_COSTS = 17
     RECORDED = 18  # rows of the record in use
     START_FITS = 19  # per tree, the size up to which every array of the tree has room for one more iteration
-    GOAL_FITS = 20
+    GOAL_FITS = 20  # (the FITS last: a solve zeroes the slots before them and keeps these)
     COUNT = 21
 
 

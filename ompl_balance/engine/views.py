@@ -19,6 +19,7 @@ This module does not import numba.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Callable
 from typing import Any
 
@@ -108,7 +109,7 @@ class EngineChecks:
 
     def made_from(self, source: tuple[Any, ...]) -> bool:
         """Whether these checks were made from the very objects ``source``."""
-        return len(source) == len(self.source) and all(a is b for a, b in zip(source, self.source))
+        return len(source) == len(self.source) and all(map(operator.is_, source, self.source))
 
     def raise_error(self) -> None:
         """Raise the error a check kept while compiled code ran, if any (clearing its flag)."""
@@ -119,13 +120,19 @@ class EngineChecks:
         raise RuntimeError("a validity check failed in compiled code and left no error to report")
 
 
+def _compiled_view(checker: Any) -> Any:
+    """A checker's or validator's ``compiled_view()``; ``None`` for one without."""
+    compiled_view = getattr(checker, "compiled_view", None)
+    return None if compiled_view is None else compiled_view()
+
+
 def checks_for(si: ob.SpaceInformation, layout: SpaceLayout, previous: EngineChecks | None = None) -> EngineChecks:
     """The check view the compiled engine uses for ``si``'s validity checker and motion validator:
     ``previous`` (the checks of an earlier solve) when it was made from the same checker,
     validator, compiled view and layout, else new checks."""
     checker, validator = si.getStateValidityChecker(), si.getMotionValidator()
-    motions = getattr(validator, "compiled_view", lambda: None)()
-    states = None if motions is not None else getattr(checker, "compiled_view", lambda: None)()
+    motions = _compiled_view(validator)
+    states = None if motions is not None else _compiled_view(checker)
     source = (checker, validator, motions if motions is not None else states, layout)
     if previous is not None and previous.made_from(source):
         return previous
