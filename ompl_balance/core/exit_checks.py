@@ -25,6 +25,7 @@ The view is a plain named tuple (this module does not import numba); its kernels
 from __future__ import annotations
 
 import enum
+import threading
 from collections.abc import Iterator
 from typing import Any, NamedTuple
 
@@ -48,6 +49,21 @@ def row_chunks(count: int) -> Iterator[tuple[int, int]]:
         last = min(count, first + size)
         yield first, last
         first, size = last, 2 * size
+
+
+#: ``tuple(row_chunks(n))`` at index ``n`` (see :func:`chunks_up_to`), and the lock that extends it.
+_CHUNK_TABLE: list[tuple[tuple[int, int], ...]] = []
+_CHUNK_TABLE_LOCK = threading.Lock()
+
+
+def chunks_up_to(count: int) -> list[tuple[tuple[int, int], ...]]:
+    """``tuple(row_chunks(n))`` at index ``n``, for every ``n`` up to ``count`` at least: one table
+    shared by every target and extended as needed (exits are hot, so a target looks its chunks up;
+    working the table out for each target cost a planner's setup some 0.2 ms)."""
+    with _CHUNK_TABLE_LOCK:
+        table = _CHUNK_TABLE
+        table.extend([tuple(row_chunks(n)) for n in range(len(table), count + 1)])
+    return table
 
 
 class Query(enum.IntEnum):

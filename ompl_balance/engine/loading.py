@@ -80,7 +80,8 @@ def _view_key(value: Any) -> Any:
     if isinstance(value, tuple):
         return tuple(view_key(item) for item in value)
     if isinstance(value, np.ndarray):
-        return (value.dtype.str, value.ndim, value.flags.c_contiguous, value.flags.writeable)
+        flags = value.flags
+        return (value.dtype.str, value.ndim, flags.c_contiguous, flags.writeable)
     return type(value)
 
 

@@ -29,7 +29,7 @@ from ompl import base as ob
 from ..core.checks import Count, exits_to_python, new_counts
 from ..core.counting import CountingValidityChecker, validity
 from ..core.discrete_motions import discrete_motions
-from ..core.exit_checks import ExitChecks, Query, exit_checks, row_chunks
+from ..core.exit_checks import ExitChecks, Query, chunks_up_to, exit_checks
 from ..core.layout import SpaceLayout
 
 
@@ -45,7 +45,7 @@ class SpaceChecks:
     def __init__(self, si: ob.SpaceInformation, is_valid: Callable[[ob.State], Any]) -> None:
         self.error: BaseException | None = None
         self.rows = np.empty((0, 0))  # the view's rows (set by take_rows once the view is made)
-        self._chunks: list[tuple[tuple[int, int], ...]] = []  # row_chunks(count) for every count
+        self._chunks: list[tuple[tuple[int, int], ...]] = []  # row_chunks(count) at index count
         self._si = si
         self._scratch = (si.allocState(), si.allocState())
         self._is_valid = is_valid
@@ -54,7 +54,7 @@ class SpaceChecks:
     def take_rows(self, rows: np.ndarray) -> None:
         """Answer about ``rows`` (the view's, (capacity, dim))."""
         self.rows = rows
-        self._chunks = [tuple(row_chunks(count)) for count in range(len(rows) + 1)]  # (worked out once: exits are hot)
+        self._chunks = chunks_up_to(len(rows))
 
     def answer(self, kind: int, count: int) -> int:
         """The answer to query ``kind`` about ``rows[:count]`` (see :class:`~ompl_balance.core.exit_checks.Query`)."""
