@@ -376,6 +376,24 @@ def exit_costs() -> None:
     print(f"the function alone, called from Python: {best * 1e6:.3f} us")
 
 
+def interleaved_medians(
+    action: Callable[[str], None], runs: int, before: Callable[[str], None] | None = None
+) -> dict[str, float]:
+    """Median microseconds of ``action(planner)`` for each of :data:`PLANNERS`, planners
+    interleaved run by run, over ``runs`` runs after ten that warm the caches; ``before(planner)``
+    runs untimed ahead of each."""
+    spent: dict[str, list[float]] = {planner: [] for planner in PLANNERS}
+    for index in range(runs + 10):
+        for planner in PLANNERS:
+            if before is not None:
+                before(planner)
+            began = time.perf_counter()
+            action(planner)
+            if index >= 10:
+                spent[planner].append(time.perf_counter() - began)
+    return {planner: statistics.median(times) * 1e6 for planner, times in spent.items()}
+
+
 def fixed_costs(solves: int = 300) -> None:
     """A solve's fixed cost: ``ss.solve`` of a 2-D problem in free space whose goal is within one
     step of its start (one iteration, two motions checked), stock and Balanced, with a trivial
@@ -395,8 +413,7 @@ def fixed_costs(solves: int = 300) -> None:
     print(f"\n### A solve's fixed cost (2-D, goal one step from the start; medians of {solves} solves)\n")
     print("| checker | stock (us) | Balanced (us) | checks per solve |\n|---|---|---|---|")
     for checker in ("callable", "numba"):
-        times: dict[str, list[float]] = {}
-        checks = 0
+        setups: dict[str, tuple[og.SimpleSetup, ob.Planner]] = {}
         for planner in PLANNERS:
             ss, counted = simple_setup(world, checker)
             si = ss.getSpaceInformation()
@@ -405,19 +422,24 @@ def fixed_costs(solves: int = 300) -> None:
             ss.setup()
             if planner == "balanced":
                 made.wait_for_engine()
-            spent = times.setdefault(planner, [])
-            for index in range(solves + 10):
-                made.clear()
-                ss.getProblemDefinition().clearSolutionPaths()
-                ptc = ob.timedPlannerTerminationCondition(10.0)
-                before, began = (counted.calls if counted else 0), time.perf_counter()
-                ss.solve(ptc)
-                if index >= 10:  # (the first solves warm the caches)
-                    spent.append(time.perf_counter() - began)
-            checks = counted.calls - before if counted else 0
-        stock, balanced = (statistics.median(times[planner]) * 1e6 for planner in PLANNERS)
-        shown = f"{checks}" if checker == "callable" else "(in compiled code)"
-        print(f"| {checker} | {stock:.0f} | {balanced:.0f} | {shown} |")
+            setups[planner] = ss, made
+
+        def cleared(planner: str, setups: dict = setups) -> None:
+            ss, made = setups[planner]
+            made.clear()
+            ss.getProblemDefinition().clearSolutionPaths()
+
+        def solved(planner: str, setups: dict = setups) -> None:
+            setups[planner][0].solve(ob.timedPlannerTerminationCondition(10.0))
+
+        medians = interleaved_medians(solved, solves, before=cleared)
+        shown = "(in compiled code)"
+        if counted is not None:  # (the last planner's: Balanced)
+            before = counted.calls
+            cleared("balanced")
+            solved("balanced")
+            shown = f"{counted.calls - before}"
+        print(f"| {checker} | {medians['stock']:.0f} | {medians['balanced']:.0f} | {shown} |")
     print("\n| before a solve (plain callable) | stock (us) | Balanced (us) | Balanced / stock |\n|---|---|---|---|")
     ss, _counted = simple_setup(world, "callable")
     ss.setup()
@@ -434,15 +456,10 @@ def fixed_costs(solves: int = 300) -> None:
         ("construction + setup()", construct_and_set_up),
         ("clear()", lambda planner: made[planner].clear()),
     ):
-        spent = {planner: [] for planner in PLANNERS}
-        for index in range(solves + 10):
-            for planner in PLANNERS:
-                began = time.perf_counter()
-                action(planner)
-                if index >= 10:
-                    spent[planner].append(time.perf_counter() - began)
-        stock, balanced = (statistics.median(spent[planner]) * 1e6 for planner in PLANNERS)
-        print(f"| {label} | {stock:.0f} | {balanced:.0f} | {balanced / stock:.1f} |")
+        medians = interleaved_medians(action, solves)
+        print(
+            f"| {label} | {medians['stock']:.0f} | {medians['balanced']:.0f} | {medians['balanced'] / medians['stock']:.1f} |"
+        )
 
 
 def main() -> None:
