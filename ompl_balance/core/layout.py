@@ -83,7 +83,8 @@ class SpaceLayout(NamedTuple):
     @property
     def euclidean(self) -> bool:
         """One real-vector leaf of weight 1: the plain Euclidean space."""
-        return len(self.kind) == 1 and self.kind[0] == Leaf.REAL and self.weight[0] == 1.0
+        # (as Python numbers: a numpy scalar compared with an enum costs microseconds)
+        return len(self.kind) == 1 and self.kind.item(0) == Leaf.REAL and self.weight.item(0) == 1.0
 
 
 def _leaves(space: ob.StateSpace, weight: float, out: list[tuple[Leaf, float, ob.StateSpace]]) -> bool:

@@ -113,9 +113,9 @@ class KDIndex(NamedTuple):
 def _first_leaf(layout: SpaceLayout, kinds: tuple[Leaf, ...], sizes: tuple[int, ...]) -> int:
     """The first leaf of one of ``kinds`` (a real-vector one of one of ``sizes``) with a
     positive weight; -1 when there is none."""
-    for leaf in range(len(layout.kind)):
-        kind = Leaf(int(layout.kind[leaf]))
-        if kind in kinds and layout.weight[leaf] > 0.0 and (kind != Leaf.REAL or layout.size[leaf] in sizes):
+    leaves = zip(layout.kind.tolist(), layout.weight.tolist(), layout.size.tolist())  # (Python numbers: faster)
+    for leaf, (kind, weight, size) in enumerate(leaves):
+        if kind in kinds and weight > 0.0 and (kind != Leaf.REAL or size in sizes):
             return leaf
     return NONE
 

@@ -109,25 +109,22 @@ SOLVE_ONLY = ("seed", "engine")
 #: round back onto its start (``Points.may_stall``), and whether the loop records what it does.
 DERIVED = (("step_may_stall", bool), ("record", bool))
 
+#: The loop's parameters: (name, the choices of a choice parameter or ``None``, the type of a number).
+_LOOP_PARAMS = tuple(
+    (row.name, row.domain.choices, row.domain.kind) for row in RRTConnectSettings.table() if row.name not in SOLVE_ONLY
+)
 _TYPES: dict[type, type] = {bool: bool, int: int, float: float, str: int}  # a choice: its number
 if TYPE_CHECKING:  # (its fields come from the table: to the type checker, any settings)
     LoopSettings = Any
 else:
-    LoopSettings = NamedTuple(
-        "LoopSettings",
-        [(row.name, _TYPES[row.domain.kind]) for row in RRTConnectSettings.table() if row.name not in SOLVE_ONLY]
-        + list(DERIVED),
-    )
+    LoopSettings = NamedTuple("LoopSettings", [(name, _TYPES[kind]) for name, _, kind in _LOOP_PARAMS] + list(DERIVED))
     LoopSettings.__doc__ = "The compiled loop's settings (see the module docstring), made from RRTConnectSettings."
 
 
 def loop_settings(settings: RRTConnectSettings, step_may_stall: bool, record: bool) -> LoopSettings:
     """The compiled loop's :data:`LoopSettings` for a planner's ``settings`` (a choice as its number)."""
     values: dict[str, Any] = {"step_may_stall": bool(step_may_stall), "record": bool(record)}
-    for row in RRTConnectSettings.table():
-        if row.name in SOLVE_ONLY:
-            continue
-        value = getattr(settings, row.name)
-        choices = row.domain.choices
-        values[row.name] = choices.index(value) if choices is not None else row.domain.kind(value)
+    for name, choices, kind in _LOOP_PARAMS:
+        value = getattr(settings, name)
+        values[name] = choices.index(value) if choices is not None else kind(value)
     return LoopSettings(**values)
