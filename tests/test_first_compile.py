@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
-import tempfile
 import time
 
+import numpy as np
 import pytest
 
 from ompl_balance.bench import first_compile
+from ompl_balance.core import kernel_cache
+from ompl_balance.core.discrete_motion_kernels import bisection_order
 
 # a module standing for a preload module: it notes when it was imported and takes a while,
 # as numba compiling would
@@ -29,7 +31,7 @@ def slow_modules(tmp_path, monkeypatch):
     (tmp_path / "imports").mkdir()
     monkeypatch.setenv("PYTHONPATH", str(modules))
     monkeypatch.setenv("IMPORTS", str(tmp_path / "imports"))
-    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # where the done markers go
+    monkeypatch.setattr(kernel_cache, "cache_folder", lambda: tmp_path)  # where the done markers go
     monkeypatch.setattr(first_compile.os, "cpu_count", lambda: 2)
     return tmp_path / "imports"
 
@@ -60,3 +62,11 @@ def test_modules_start_in_order_and_the_next_as_soon_as_any_ends(slow_modules):
     assert spans["long"][0] < spans["slow_one"][0] and spans["short"][0] < spans["slow_one"][0]
     # slow_one takes the core short leaves, while long (started first) still runs
     assert spans["short"][1] <= spans["slow_one"][0] < spans["long"][1]
+
+
+def test_the_note_that_a_module_compiled_is_kept_where_numba_caches_the_packages_kernels():
+    # a reinstall in the same place empties numba's cache: a note kept elsewhere (the temporary
+    # folder) would outlive it and the next first run would compile on one core
+    bisection_order(4, np.zeros((4, 2), dtype=np.int64), np.zeros(4, dtype=np.int64))  # cached, or compiled
+    folder = first_compile._done_marker("some_module").parent
+    assert any(folder.glob("discrete_motion_kernels.bisection_order-*.nbi"))  # numba's own index of it

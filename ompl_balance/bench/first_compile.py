@@ -23,12 +23,14 @@ _POLL = 0.1
 
 
 def _done_marker(module: str) -> Path:
-    """The file that says ``module``'s kernels were compiled for this copy of the package."""
-    from ..core.kernel_cache import PACKAGE, package_digest
+    """The file that says ``module``'s kernels were compiled for this copy of the package: kept
+    in numba's cache of the package (a reinstall that empties the cache removes it too), else in
+    the temporary folder."""
+    from ..core.kernel_cache import PACKAGE, cache_folder, package_digest
 
     cache = os.environ.get("NUMBA_CACHE_DIR", "")
     key = hashlib.sha256(f"{PACKAGE} {cache} {package_digest()} {module}".encode()).hexdigest()[:16]
-    return Path(tempfile.gettempdir()) / f"ompl_balance-compiled-{key}"
+    return (cache_folder() or Path(tempfile.gettempdir())) / f"ompl_balance-compiled-{key}"
 
 
 def compile_in_parallel(modules: list[str]) -> None:

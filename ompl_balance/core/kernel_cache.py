@@ -24,7 +24,7 @@ from typing import Any, TypeVar, cast
 import numba
 from numba.core import caching
 
-__all__ = ["PackageCacheLocator", "njit", "njit_borrowing", "package_digest"]
+__all__ = ["PackageCacheLocator", "cache_folder", "njit", "njit_borrowing", "package_digest"]
 
 _Kernel = TypeVar("_Kernel", bound=Callable[..., Any])
 
@@ -69,6 +69,14 @@ def package_digest() -> str:
         digest.update(path.read_bytes())
         digest.update(b"\0")
     return digest.hexdigest()
+
+
+def cache_folder() -> Path | None:
+    """The folder where numba keeps the cached kernels of this module's folder (``core``'s, in the
+    package's tree, under ``NUMBA_CACHE_DIR`` or in the user's cache, as numba decides); ``None``
+    where numba can keep none. What is kept there goes when the cache does (a reinstall)."""
+    locator = PackageCacheLocator.from_function(cache_folder, __file__)
+    return None if locator is None else Path(locator.get_cache_path())
 
 
 def _in_package(py_file: str) -> bool:
