@@ -26,6 +26,7 @@ from test_validity import arm3_scene
 
 from ompl_balance.collision.budget import FCL_QUERY_WORK, MOTION_BUDGET
 from ompl_balance.collision.certified import MotionCertifier
+from ompl_balance.collision.certified_lines import ALONG_TOLERANCE, along_certified, certified_lines, remember_certified
 from ompl_balance.collision.checker import CollisionChecker
 from ompl_balance.collision.environment import Environment
 from ompl_balance.collision.rigid.body import RigidBody
@@ -216,6 +217,92 @@ def test_simplify_solution_keeps_its_time_limit():
     oracle = CollisionChecker(robot, box_problem(2).environment)
     for a, b in itertools.pairwise(np.array(result["states"])):
         assert dense_first_collision(oracle, a, b) is None
+
+
+# ------------------------------------------------------------------------- pieces of certified edges
+
+
+def test_along_certified_is_both_ends_on_a_kept_edge():
+    """Against the geometry (an independent numpy oracle): a motion is along a kept edge when both
+    its ends lie on the edge's segment, to rounding; not beyond its ends, not a hair off it, not
+    from one edge to another, and not along an edge the ring has overwritten."""
+    rng = np.random.default_rng(11)
+    dof = 7
+    lines = certified_lines(4, dof)
+    edges = [(rng.uniform(-2, 2, dof), rng.uniform(-2, 2, dof)) for _ in range(5)]
+    for a, b in edges:
+        remember_certified(lines, a, b)
+    (a0, b0), kept = edges[0], edges[1:]  # (the fifth edge took the first one's place)
+    assert not along_certified(lines, a0, b0)
+    for a, b in kept:
+        for _ in range(20):
+            s, t = rng.uniform(0, 1, 2)
+            p, q = a + s * (b - a), a + t * (b - a)
+            assert along_certified(lines, p, q) and along_certified(lines, q, p)
+            assert along_certified(lines, p, p)
+            across = rng.normal(size=dof)
+            across -= across @ (b - a) / ((b - a) @ (b - a)) * (b - a)  # (at a right angle to the edge)
+            across /= np.linalg.norm(across)
+            assert np.linalg.norm(across * 1e-14) < ALONG_TOLERANCE
+            assert along_certified(lines, p + 1e-14 * across, q)  # (rounding)
+            assert not along_certified(lines, p + 1e-9 * across, q)
+            assert not along_certified(lines, p, a + 1.001 * (b - a))
+            assert not along_certified(lines, a - 0.001 * (b - a), q)
+    (a1, b1), (a2, b2) = kept[:2]
+    assert not along_certified(lines, (a1 + b1) / 2, (a2 + b2) / 2)
+
+
+def edge_whose_fresh_proof_exceeds_its_remembered_one(checker, rng):
+    """An edge ``a -> b`` and a budget ``units`` within which a certifier refuses the edge the
+    first time and certifies it the second, with the bounds at its ends remembered (``units``:
+    the second proof's work, counted by a certifier with no budget)."""
+    for a, b in random_edges(checker.robot, checker, 200, rng, longest=0.6):
+        unbounded = MotionCertifier(checker, motion_budget=None)
+        if not unbounded.check(a, b)[0]:
+            continue
+        before = checker.counters()
+        unbounded.check(a, b)
+        after = checker.counters()
+        units = sum(after[key] - before[key] for key in ("states_checked", "distance_queries"))
+        budgeted = MotionCertifier(checker, motion_budget=max(units, 1))
+        if not budgeted.check(a, b)[0] and budgeted.check(a, b)[0]:
+            return a, b, max(units, 1)
+    raise AssertionError("no such edge among 200 (the search's premise no longer holds)")
+
+
+def test_an_edge_certified_before_is_certified_again_when_its_own_proof_no_longer_fits():
+    """OMPL's simplifier checks a path's edges again long after the planner certified them; by then
+    the bounds at their ends are forgotten and the proof from scratch may exceed the budget. The
+    validator must still accept the edges it certified (OMPL's ``PathGeometric::check``, through
+    ``checkMotion``), and the pieces ``subdivide`` cuts them into: a refusal there makes
+    ``checkAndRepair`` put random states into the path. Oracles: a fresh validator with the same
+    budget refuses the edge (the premise), and a dense exact re-check finds it free."""
+    robot = panda()
+    environment = load_mbm("bookshelf_small", robot.joint_names)[1].environment
+    checker = CollisionChecker(robot, environment)
+    a, b, units = edge_whose_fresh_proof_exceeds_its_remembered_one(checker, np.random.default_rng(5))
+    si = og.SimpleSetup(space_for(robot)).getSpaceInformation()
+    validator = setup_robot(si, checker, motion_budget=units)[1]
+    fresh = setup_robot(og.SimpleSetup(space_for(robot)).getSpaceInformation(), checker, motion_budget=units)[1]
+    path = og.PathGeometric(si)
+    for q in (a, b):
+        state = si.allocState()
+        for j, value in enumerate(q):
+            state[j] = float(value)
+        path.append(state)
+    ends = path.getState(0), path.getState(1)
+    assert not fresh.checkMotion(*ends)  # (the proof from scratch exceeds the budget)
+    assert not validator.checkMotion(*ends)  # (so does the first: nothing remembered yet)
+    assert validator.checkMotion(*ends)  # (the bounds at its ends remembered: certified)
+    for step in range(300):  # other edges, until the bounds at a and b are forgotten
+        q = a + 0.05 * np.sin(np.arange(robot.dof) + step)
+        validator.certifier.check(q, q + 0.01)
+    assert path.check()  # (OMPL's own check: every edge through checkMotion)
+    path.subdivide()
+    path.subdivide()
+    assert path.check()
+    assert validator.check_motion_last_valid(path.getState(1), path.getState(3)) == (True, 1.0)
+    assert dense_first_collision(CollisionChecker(robot, environment), a, b) is None
 
 
 # ------------------------------------------------------------------------------------------ rigid bodies

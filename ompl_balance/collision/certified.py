@@ -67,6 +67,11 @@ FCL distances for a link sliding past an obstacle a fraction of a millimetre awa
 check has a work budget (``motion_budget``, :mod:`ompl_balance.collision.budget`): a proof that
 would exceed it stops and the edge is not certified, counted in the checker's
 ``motions_over_budget``.
+
+A motion that lies on an edge certified lately is certified by that edge's proof, whether or not
+its own proof would fit the budget (:mod:`~ompl_balance.collision.certified_lines`): OMPL's path
+simplifier cuts a path's edges into pieces and checks them again, and a refused piece of a free
+edge makes it put random states into the path.
 """
 
 from __future__ import annotations
@@ -93,6 +98,7 @@ from .advancement import (
 )
 from .bisection import bisect_segments, contact_at_middles
 from .budget import MOTION_BUDGET, UNLIMITED, OverBudgetError, WorkBudget, budget_units
+from .certified_lines import LINES_REMEMBERED, along_certified, certified_lines, remember_certified
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
 from .kernels import CertifiedMotions, certified_edge_free, robot_states
@@ -169,8 +175,15 @@ class MotionCertifier:
         # the compiled kernels are called without numba's type dispatch (several microseconds
         # of an edge's few tens): the argument types are fixed here
         lower = np.ascontiguousarray(robot.lower, dtype=float)
+        self._lines = certified_lines(LINES_REMEMBERED, robot.dof)
         self._view = CertifiedMotions(
-            robot_states(checker), self._edge, self._memory, self._scratch, exit_handle(self), checker.counter.array
+            robot_states(checker),
+            self._edge,
+            self._memory,
+            self._lines,
+            self._scratch,
+            exit_handle(self),
+            checker.counter.array,
         )
         self._row = entry_point(memory_row, (self._memory, lower))
         self._advance = entry_point(
@@ -178,8 +191,11 @@ class MotionCertifier:
             (lower, lower, self._edge, self._memory.bounds, 0, 1, MIN_TRAVEL, True, False, self._scratch, self._budget),
         )
         self._edge_free = entry_point(
-            certified_edge_free, (self._edge, self._memory, self._scratch, checker.counter.array, 0, lower, lower)
+            certified_edge_free,
+            (self._edge, self._memory, self._lines, self._scratch, checker.counter.array, 0, lower, lower),
         )
+        self._remember = entry_point(remember_certified, (self._lines, lower, lower))
+        self._along = entry_point(along_certified, (self._lines, lower, lower))
 
     def _build_model(self) -> Model:
         robot, obstacles = self._robot, self.checker.environment.obstacles
@@ -232,19 +248,37 @@ class MotionCertifier:
         :data:`LAST_VALID_TRAVEL` of travel, and ``a + s (b - a)`` is certified for every ``s``
         up to the fraction returned. A check whose proof would exceed :attr:`motion_budget`
         stops there: not certified (with ``last_valid``, certified up to the first stretch left
-        unproved), counted in the checker's ``motions_over_budget``.
+        unproved), counted in the checker's ``motions_over_budget``. An edge whose proof fails but
+        that lies on an edge certified lately is certified by that edge
+        (:mod:`~ompl_balance.collision.certified_lines`); every certified edge is kept for that.
         """
         a = np.ascontiguousarray(a, dtype=float)
         b = np.ascontiguousarray(b, dtype=float)
+        counter = self.checker.counter
         if a.shape != (self._robot.dof,) or b.shape != a.shape:
-            self.checker.counter.motions_checked += 1
+            counter.motions_checked += 1
             return False, 0.0
         if self.checker.prefilter and not last_valid:
             view = self._view
-            free = bool(self._edge_free(view.edge, view.memory, view.scratch, view.counts, view.handle, a, b))
+            free = bool(
+                self._edge_free(view.edge, view.memory, view.lines, view.scratch, view.counts, view.handle, a, b)
+            )
             return free, 1.0 if free else 0.0
-        counter = self.checker.counter
         counter.motions_checked += 1
+        free, fraction, over_budget = self._prove(a, b, last_valid)
+        if free:
+            self._remember(self._lines, a, b)
+            return True, 1.0
+        if self._along(self._lines, a, b):
+            return True, 1.0
+        if over_budget:
+            counter.motions_over_budget += 1
+        return False, fraction if last_valid else 0.0
+
+    def _prove(self, a: np.ndarray, b: np.ndarray, last_valid: bool) -> tuple[bool, float, bool]:
+        """The proof of ``a -> b`` in Python's hands (``last_valid``, or no prefilter): whether it
+        certifies the edge, the fraction certified from ``a``, and whether the budget ran out."""
+        counter = self.checker.counter
         start, end = self._row(self._memory, a), self._row(self._memory, b)
         settle = max(MIN_TRAVEL, LAST_VALID_TRAVEL) if last_valid else MIN_TRAVEL
         budget = WorkBudget(self._budget)
@@ -256,17 +290,16 @@ class MotionCertifier:
             counter.distance_queries += bounded
             budget = WorkBudget(self._budget - evaluated - bounded)  # (what the FCL phase may spend)
             if exhausted:  # (the hard segments' starts are in bad: they are not finished)
-                counter.motions_over_budget += 1
-                return False, bad if last_valid else 0.0
+                return False, bad, True
             if failed and bad == 0.0:
-                return False, 0.0
+                return False, 0.0, False
             if hard == 0:
-                return (False, bad) if failed else (True, 1.0)
+                return (False, bad, False) if failed else (True, 1.0, False)
             pairs, spans = hard_pair[:hard], hard_span[:hard]
         else:  # the reference: every pair over the whole edge with FCL only
             inside = self._robot.within_limits(np.stack([a, b]))
             if not inside.all():
-                return False, 0.0
+                return False, 0.0, False
             delta = np.abs(b - a)
             per_geometry = self._model.environment_weight @ delta
             self._scratch.speed[:] = np.concatenate(
@@ -276,11 +309,7 @@ class MotionCertifier:
             pairs = np.arange(self.pair_count)
             spans = np.tile([0.0, 1.0, -np.inf, -np.inf], (self.pair_count, 1))
         failed, bad = self._exact_phase(a, b, pairs, spans, start, end, settle, last_valid, failed, bad, budget)
-        if budget.exhausted:
-            counter.motions_over_budget += 1
-        if failed:
-            return False, bad if last_valid else 0.0
-        return True, 1.0
+        return (False, bad, budget.exhausted) if failed else (True, 1.0, budget.exhausted)
 
     def compiled_view(self) -> CertifiedMotions:
         """The certifier as compiled code sees it (:class:`~ompl_balance.collision.kernels.CertifiedMotions`)."""

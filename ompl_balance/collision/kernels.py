@@ -34,6 +34,7 @@ from ..core.kernel_cache import njit
 from ..core.layout import SpaceLayout
 from .advancement import EdgeModel, EdgeScratch, EndMemory, advance, memory_row
 from .budget import OverBudgetError, WorkBudget
+from .certified_lines import CertifiedLines, along_certified, certified_lines, remember_certified
 from .kinematics import LIMIT_TOLERANCE, Chain
 from .screening import Volumes, screen
 
@@ -228,18 +229,21 @@ def robot_discrete_motion_free(view: RobotDiscreteMotions, a: np.ndarray, b: np.
 class CertifiedMotions(NamedTuple):
     """Certified motions as compiled code sees them: the checker's ``states`` view, the
     certifier's ``edge`` model, end ``memory`` and ``scratch`` (:mod:`~ompl_balance.collision.advancement`),
+    the edges it certified lately (:mod:`~ompl_balance.collision.certified_lines`),
     the exit ``handle`` to the certifier (FCL on the hard segments) and the work ``counts``."""
 
     states: RobotStates
     edge: EdgeModel
     memory: EndMemory
+    lines: CertifiedLines
     scratch: EdgeScratch
     handle: int
     counts: np.ndarray
 
 
 #: What the exits to FCL answer: no (not free, no contact), yes (free, a contact), or the
-#: motion's work budget ran out first.
+#: motion's work budget ran out first; and a motion's proof (:func:`prove_edge`): no, yes (certified)
+#: or over budget.
 EXIT_NO, EXIT_YES, EXIT_OVER_BUDGET = 0, 1, 2
 
 
@@ -266,26 +270,55 @@ def _touching(
 def certified_edge_free(
     edge: EdgeModel,
     memory: EndMemory,
+    lines: CertifiedLines,
     scratch: EdgeScratch,
     counts: np.ndarray,
     handle: int,
     a: np.ndarray,
     b: np.ndarray,
 ) -> bool:  # pragma: no cover (compiled)
-    """:meth:`MotionCertifier.check` of ``a -> b`` (no ``last_valid``): advancement, stopping at
-    the first failure, then FCL on the hard segments through the exit ``handle``. Counts one
-    motion, the configurations evaluated and the distance queries in ``counts``. (The parts of
-    a :class:`CertifiedMotions` view it needs, so that Python callers pass no more.)
+    """:meth:`MotionCertifier.check` of ``a -> b`` (no ``last_valid``): the proof
+    (:func:`prove_edge`), kept in ``lines`` when it certifies the motion; a motion it does not
+    certify is still certified when it lies on an edge kept there (a piece of a certified edge,
+    :mod:`~ompl_balance.collision.certified_lines`). Counts one motion, and a refusal for the
+    budget in ``counts[Count.OVER_BUDGET]``. (The parts of a :class:`CertifiedMotions` view it
+    needs, so that Python callers pass no more.)
+    """
+    counts[Count.MOTIONS] += 1
+    proof = prove_edge(edge, memory, scratch, counts, handle, a, b)
+    if proof == EXIT_YES:
+        remember_certified(lines, a, b)
+        return True
+    if along_certified(lines, a, b):
+        return True
+    if proof == EXIT_OVER_BUDGET:
+        counts[Count.OVER_BUDGET] += 1
+    return False
+
+
+@njit(cache=True)
+def prove_edge(
+    edge: EdgeModel,
+    memory: EndMemory,
+    scratch: EdgeScratch,
+    counts: np.ndarray,
+    handle: int,
+    a: np.ndarray,
+    b: np.ndarray,
+) -> int:  # pragma: no cover (compiled)
+    """The proof that ``a -> b`` is free: advancement, stopping at the first failure, then FCL
+    on the hard segments through the exit ``handle``; ``EXIT_YES`` (certified), ``EXIT_NO`` (a
+    contact, or a segment that cannot be certified) or ``EXIT_OVER_BUDGET``. Counts the
+    configurations evaluated and the distance queries in ``counts``.
 
     Where a non-convex pair's convex parts touch, the advancement stops at the end of that
     bisection level and FCL tests those segments for a contact first (most such edges collide
     there); only if it finds none is the edge certified in full.
 
-    The bound: the work of the whole check (both advancement passes and the FCL queries of the
-    exits, :mod:`ompl_balance.collision.budget`) <= ``edge.budget``; a check that would need
-    more refuses the motion and counts in ``counts[Count.OVER_BUDGET]``.
+    The bound: the work of the whole proof (both advancement passes and the FCL queries of the
+    exits, :mod:`ompl_balance.collision.budget`) <= ``edge.budget``; a proof that would need
+    more stops with ``EXIT_OVER_BUDGET``.
     """
-    counts[Count.MOTIONS] += 1
     start, end = memory_row(memory, a), memory_row(memory, b)
     spent = 0
     # (``stop`` as a plain bool: numba's literal True would compile advance a second time, 12 s,
@@ -299,26 +332,22 @@ def certified_edge_free(
         counts[Count.DISTANCE_QUERIES] += bounded
         spent += evaluated + bounded
         if exhausted:
-            counts[Count.OVER_BUDGET] += 1
-            return False
+            return EXIT_OVER_BUDGET
         if failed:
-            return False
+            return EXIT_NO
         if bad == 1.0:  # certified but for the hard segments
             break
         counts[Count.EXITS] += 1  # undecided at a touching segment: FCL looks there first
         touching, used = hard_segments_touch(handle, a, b, hard_pair[:hard], hard_span[:hard], edge.budget - spent)
         spent += used
         if touching == EXIT_OVER_BUDGET:
-            counts[Count.OVER_BUDGET] += 1
+            return EXIT_OVER_BUDGET
         if touching != EXIT_NO:
-            return False
+            return EXIT_NO
     if hard == 0:
-        return True
+        return EXIT_YES
     counts[Count.EXITS] += 1
-    free = hard_segments_free(handle, a, b, hard_pair[:hard], hard_span[:hard], start, end, edge.budget - spent)
-    if free == EXIT_OVER_BUDGET:
-        counts[Count.OVER_BUDGET] += 1
-    return free == EXIT_YES
+    return hard_segments_free(handle, a, b, hard_pair[:hard], hard_span[:hard], start, end, edge.budget - spent)
 
 
 @njit(cache=True)
@@ -347,7 +376,7 @@ def hard_segments_touch(
 @njit(cache=True)
 def certified_motion_free(view: CertifiedMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """The certified motion kernel of a :class:`CertifiedMotions` view (:func:`certified_edge_free`)."""
-    return certified_edge_free(view.edge, view.memory, view.scratch, view.counts, view.handle, a, b)
+    return certified_edge_free(view.edge, view.memory, view.lines, view.scratch, view.counts, view.handle, a, b)
 
 
 @njit(cache=True)
@@ -437,9 +466,10 @@ def warm_up() -> None:
     scratch = EdgeScratch(
         np.zeros((0, 3)), np.zeros((4, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), np.zeros((1, 4))
     )
-    certified = CertifiedMotions(states, edge, end_memory(2, 1, 0), scratch, 0, states.counts)
+    certified = CertifiedMotions(states, edge, end_memory(2, 1, 0), certified_lines(1, 1), scratch, 0, states.counts)
     certified_motion_free(certified, q, q)
-    certified_edge_free(edge, certified.memory, scratch, states.counts, 0, q, q)  # (the Python callers')
+    # (and the kernel the Python callers reach through the certifier's entry point)
+    certified_edge_free(edge, certified.memory, certified.lines, scratch, states.counts, 0, q, q)
     warm_exits_once()
 
 
