@@ -229,7 +229,9 @@ def test_along_certified_is_both_ends_on_a_kept_edge():
     rng = np.random.default_rng(11)
     dof = 7
     lines = certified_lines(4, dof)
-    edges = [(rng.uniform(-2, 2, dof), rng.uniform(-2, 2, dof)) for _ in range(5)]
+    edges = [(rng.uniform(-2, 2, dof), rng.uniform(-2, 2, dof)) for _ in range(4)]
+    tie = rng.uniform(-2, 2, dof)  # (two joints move most, equally: either may lead a piece)
+    edges.append((tie, tie + np.array([0.7, -0.7, 0.3, 0.0, 0.0, 0.0, 0.1])))
     for a, b in edges:
         remember_certified(lines, a, b)
     (a0, b0), kept = edges[0], edges[1:]  # (the fifth edge took the first one's place)

@@ -37,11 +37,13 @@ LINES_REMEMBERED = 2048
 class CertifiedLines(NamedTuple):
     """The last certified edges ``a -> b``, oldest overwritten first: ``starts`` (n, dof) the
     ``a``, ``directions`` (n, dof) the unit vectors ``(b - a) / |b - a|``, ``lengths`` (n,) the
-    ``|b - a|``, ``next`` (1,) the row written next, ``filled`` (1,) how many rows hold an edge."""
+    ``|b - a|``, ``axes`` (n,) the joint that moves most along each, ``next`` (1,) the row written
+    next, ``filled`` (1,) how many rows hold an edge."""
 
     starts: np.ndarray
     directions: np.ndarray
     lengths: np.ndarray
+    axes: np.ndarray
     next: np.ndarray
     filled: np.ndarray
 
@@ -52,6 +54,7 @@ def certified_lines(capacity: int, dof: int) -> CertifiedLines:
         np.zeros((capacity, dof)),
         np.zeros((capacity, dof)),
         np.zeros(capacity),
+        np.zeros(capacity, dtype=np.int64),
         np.zeros(1, dtype=np.int64),
         np.zeros(1, dtype=np.int64),
     )
@@ -74,10 +77,14 @@ def remember_certified(lines: CertifiedLines, a: np.ndarray, b: np.ndarray) -> N
     if length <= ALONG_TOLERANCE:
         return
     row = lines.next[0]
+    axis = 0
     for j in range(a.shape[0]):
         lines.starts[row, j] = a[j]
         lines.directions[row, j] = (b[j] - a[j]) / length
+        if abs(b[j] - a[j]) > abs(b[axis] - a[axis]):
+            axis = j
     lines.lengths[row] = length
+    lines.axes[row] = axis
     lines.next[0] = (row + 1) % lines.lengths.shape[0]
     lines.filled[0] = min(lines.filled[0] + 1, lines.lengths.shape[0])
 
@@ -100,12 +107,22 @@ def _on_line(lines: CertifiedLines, row: int, q: np.ndarray) -> bool:  # pragma:
 @njit_borrowing
 def along_certified(lines: CertifiedLines, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover (compiled)
     """Whether the motion ``a -> b`` (dof,) lies on one edge kept in ``lines``: both its ends on
-    the edge's segment, so the whole motion is (the segment is convex). A kept edge whose
-    direction is not that of the motion (to 1e-6 in the cosine) is passed over at the cost of
-    one dot product."""
+    the edge's segment, so the whole motion is (the segment is convex).
+
+    An edge is passed over at the cost of a comparison when the joint it moves most is not one
+    the motion moves most too (within 1e-6: a piece moves its joints in the same proportions, to
+    rounding), and at the cost of a dot product when its direction is not the motion's (to 1e-6
+    in the cosine): about 2 us for 2,048 edges of a 7-joint arm.
+    """
     length = _distance(a, b)
+    most = 0.0
+    for j in range(a.shape[0]):
+        most = max(most, abs(b[j] - a[j]))
     for row in range(lines.filled[0]):
         if length > ALONG_TOLERANCE:  # (a motion of no length is a configuration on the edge)
+            axis = lines.axes[row]
+            if abs(b[axis] - a[axis]) < (1.0 - 1e-6) * most:
+                continue
             cosine = 0.0
             for j in range(a.shape[0]):
                 cosine += (b[j] - a[j]) * lines.directions[row, j]
