@@ -252,6 +252,10 @@ def test_along_certified_is_both_ends_on_a_kept_edge():
             assert not along_certified(lines, a - 0.001 * (b - a), q)
     (a1, b1), (a2, b2) = kept[:2]
     assert not along_certified(lines, (a1 + b1) / 2, (a2 + b2) / 2)
+    for bad in (np.nan, np.inf, -np.inf):
+        q = a1.copy()
+        q[3] = bad
+        assert not along_certified(lines, a1, q) and not along_certified(lines, q, q)
 
 
 def edge_whose_fresh_proof_exceeds_its_remembered_one(checker, rng):
@@ -304,6 +308,11 @@ def test_an_edge_certified_before_is_certified_again_when_its_own_proof_no_longe
     path.subdivide()
     assert path.check()
     assert validator.check_motion_last_valid(path.getState(1), path.getState(3)) == (True, 1.0)
+    for bad in (np.nan, np.inf):
+        far = si.allocState()
+        for j, value in enumerate(b):
+            far[j] = bad if j == 2 else float(value)
+        assert not validator.checkMotion(path.getState(0), far)
     assert dense_first_collision(CollisionChecker(robot, environment), a, b) is None
 
 

@@ -91,15 +91,17 @@ def remember_certified(lines: CertifiedLines, a: np.ndarray, b: np.ndarray) -> N
 
 @njit_borrowing
 def _on_line(lines: CertifiedLines, row: int, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
-    """Whether ``q`` (dof,) lies on the edge in ``row`` of ``lines`` (within :data:`ALONG_TOLERANCE`)."""
+    """Whether ``q`` (dof,) lies on the edge in ``row`` of ``lines`` (within :data:`ALONG_TOLERANCE`);
+    never for a ``q`` with a non-finite value."""
     start, direction = lines.starts[row], lines.directions[row]
     along = 0.0
     for j in range(q.shape[0]):
         along += (q[j] - start[j]) * direction[j]
-    if along < -ALONG_TOLERANCE or along > lines.lengths[row] + ALONG_TOLERANCE:
+    # (every test written so that a NaN fails it: a non-finite q is on no edge)
+    if not (-ALONG_TOLERANCE <= along <= lines.lengths[row] + ALONG_TOLERANCE):
         return False
     for j in range(q.shape[0]):  # noqa: SIM110 (a loop numba compiles)
-        if abs(q[j] - start[j] - along * direction[j]) > ALONG_TOLERANCE:
+        if not abs(q[j] - start[j] - along * direction[j]) <= ALONG_TOLERANCE:
             return False
     return True
 
