@@ -87,17 +87,7 @@ def show(
     if file is not None:
         return write_page(scene, plan, frames, file, trees).path
     viewer = LiveViewer(scene, plan, frames, trees, host, port)
-    try:
-        if open_browser:
-            import webbrowser
-
-            webbrowser.open(viewer.url)
-        if wait:
-            print(f"showing {scene.title} at {viewer.url} (Ctrl-C to stop)")
-            viewer.wait()
-    except BaseException:  # (a Ctrl-C before or during the wait too: the server stops either way)
-        viewer.stop()
-        raise
+    viewer.present(open_browser, wait)
     return viewer
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 from dataclasses import dataclass
@@ -121,16 +122,7 @@ def run_show(
         print(f"wrote {page.path} ({size / 1e6:.1f} MB, {time.perf_counter() - began:.1f} s): open it in a browser")
     else:
         viewer = LiveViewer(scene, plan, planned.frames, trees, host, port)
-        try:  # (a Ctrl-C from the moment the address is out stops the viewer, before the wait as in it)
-            print(f"showing {scene.title} at {viewer.url} (Ctrl-C to stop)", flush=True)
-            if open_browser:
-                import webbrowser
-
-                webbrowser.open(viewer.url)
-            viewer.wait()
-        except KeyboardInterrupt:
-            pass
-        finally:
-            viewer.stop()
+        with contextlib.suppress(KeyboardInterrupt):  # (one before the wait: the viewer stopped all the same)
+            viewer.present(open_browser)
         print("viewer stopped")
     return 0 if planned.solved else 1

@@ -117,6 +117,23 @@ class LiveViewer:
             self._playing.clear()
         self._play.label = "pause" if playing else "play"
 
+    def present(self, open_browser: bool = True, wait: bool = True) -> None:
+        """Say where the viewer is and open it in the browser (``open_browser``), then (``wait``)
+        wait until Ctrl-C. Anything raised on the way, a Ctrl-C before the wait included, stops
+        the server before it goes on."""
+        try:
+            if wait:
+                print(f"showing {self.scene.title} at {self.url} (Ctrl-C to stop)", flush=True)
+            if open_browser:
+                import webbrowser
+
+                webbrowser.open(self.url)
+            if wait:
+                self.wait()
+        except BaseException:
+            self.stop()
+            raise
+
     def wait(self) -> None:
         """Block until Ctrl-C (or :meth:`stop` from another thread), then stop the server."""
         try:
