@@ -290,9 +290,9 @@ for planner_class in (ompl_balance.BalancedRRTConnect, ompl_balance.BallRadiusRR
     for limit in (0.5, 0.0, -1.0):
         ss = wall.setup()
         ss.setPlanner(planner_class(ss.getSpaceInformation()))
-        began = time.perf_counter()
+        on_wall_clock, began = time.time(), time.perf_counter()
         ss.solve(limit)
-        times.append(time.perf_counter() - began)
+        times += [time.time() - on_wall_clock, time.perf_counter() - began]  # (OMPL's clock, the monotonic one)
 print(*times)
 """
 
@@ -300,8 +300,8 @@ print(*times)
 def test_a_fresh_processs_first_solve_takes_its_time_limit_and_no_more():
     """The first ss.solve(0.5) of a process returns after 0.5 s and one iteration (it used
     to load the compiled kernels inside, 1.1 s); solve(0) and solve(-1) return at once."""
-    rrtc, rrtc_zero, rrtc_negative, rrtstar, rrtstar_zero, rrtstar_negative = map(
-        float, run_with_seed(FIRST_SOLVE, 0).split()
-    )
-    assert 0.5 <= rrtc < 0.8 and 0.5 <= rrtstar < 0.8, (rrtc, rrtstar)
-    assert max(rrtc_zero, rrtc_negative, rrtstar_zero, rrtstar_negative) < 0.1
+    times = [float(value) for value in run_with_seed(FIRST_SOLVE, 0).split()]
+    (rrtc, rrtc_zero, rrtc_negative, rrtstar, rrtstar_zero, rrtstar_negative) = zip(times[::2], times[1::2])
+    # (at least the limit on OMPL's clock, the wall clock; at most a little more on the monotonic one)
+    assert rrtc[0] >= 0.5 and rrtc[1] < 0.8 and rrtstar[0] >= 0.5 and rrtstar[1] < 0.8, (rrtc, rrtstar)
+    assert max(took[1] for took in (rrtc_zero, rrtc_negative, rrtstar_zero, rrtstar_negative)) < 0.1
