@@ -1,15 +1,21 @@
-"""The first sweep after installing: the forkserver's modules compiled in parallel processes, once."""
+"""The first sweep after installing: the forkserver's modules compiled in parallel processes, once;
+the first test run: the engine's kinds of check compiled ahead of the tests that need them."""
 
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
+import compile_ahead
 import numpy as np
 import pytest
 
 from ompl_balance.bench import first_compile
 from ompl_balance.core import kernel_cache
 from ompl_balance.core.discrete_motion_kernels import bisection_order
+from ompl_balance.core.layout import layout_for
+from ompl_balance.engine.loading import view_key
+from ompl_balance.engine.views import checks_for
 
 # a module standing for a preload module: it notes when it was imported and takes a while,
 # as numba compiling would
@@ -70,3 +76,41 @@ def test_the_note_that_a_module_compiled_is_kept_where_numba_caches_the_packages
     bisection_order(4, np.zeros((4, 2), dtype=np.int64), np.zeros(4, dtype=np.int64))  # cached, or compiled
     folder = first_compile._done_marker("some_module").parent
     assert any(folder.glob("discrete_motion_kernels.bisection_order-*.nbi"))  # numba's own index of it
+
+
+def test_the_suite_compiles_each_kind_of_check_ahead_once():
+    keys = []
+    for make in compile_ahead.KINDS:
+        si = make().getSpaceInformation()
+        si.setup()
+        layout = layout_for(si.getStateSpace())
+        keys.append(view_key((checks_for(si, layout).view, layout)))
+    assert len(set(keys)) == len(keys)  # each a kind of its own: one compilation of the engine each
+
+
+def test_compiling_ahead_ends_with_the_session_and_leaves_no_process():
+    if not Path("/proc/self/stat").is_file():
+        pytest.skip("no /proc to list processes by group")
+    process = compile_ahead.start()
+    if process is None:
+        pytest.skip("one core: nothing is compiled ahead")
+    time.sleep(2.0)  # (under way: importing, or an engine compiling in a process it started)
+    compile_ahead.stop(process)
+    assert process.returncode is not None
+    # nor any process it started (its session's group), once the system has reaped them
+    deadline = time.monotonic() + 30.0
+    while _group_alive(process.pid) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not _group_alive(process.pid)
+
+
+def _group_alive(group: int) -> bool:
+    """Whether a process of process group ``group`` runs (a zombie, dead but not yet reaped, does not)."""
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rpartition(")")[2].split()  # (after the command's name)
+        except OSError:  # (ended meanwhile)
+            continue
+        if int(fields[2]) == group and fields[0] != "Z":
+            return True
+    return False
