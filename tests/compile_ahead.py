@@ -97,12 +97,14 @@ KINDS: tuple[Callable[[], og.SimpleSetup], ...] = (
 )
 
 
-def make_ready() -> None:
+def make_ready(parent: int) -> None:
     """Make the compiled engine ready for each of :data:`KINDS` (compiled into numba's cache,
-    or loaded from it)."""
+    or loaded from it), while process ``parent`` (the tests') runs."""
     from ompl_balance import BalancedRRTConnect
 
     for make in KINDS:
+        if os.getppid() != parent:  # (the tests ended without stopping this process: killed)
+            return
         ss = make()
         planner = BalancedRRTConnect(ss.getSpaceInformation())
         planner.setEngine("compiled")
@@ -121,7 +123,7 @@ def start() -> subprocess.Popen[bytes] | None:
     package_parent = str(Path(ompl_balance.__file__).resolve().parents[1])
     path = os.pathsep.join(filter(None, (package_parent, os.environ.get("PYTHONPATH"))))
     return subprocess.Popen(
-        [sys.executable, str(Path(__file__).resolve())],
+        [sys.executable, str(Path(__file__).resolve()), str(os.getpid())],
         env={**os.environ, "PYTHONPATH": path},
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
@@ -144,4 +146,4 @@ if __name__ == "__main__":
     from ompl import util as ou
 
     ou.setLogLevel(ou.LOG_ERROR)
-    make_ready()
+    make_ready(parent=int(sys.argv[1]))
