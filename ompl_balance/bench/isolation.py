@@ -124,26 +124,48 @@ def _plain_child(task: RunTask, connection: Any) -> None:
     connection.send(time.perf_counter() - began)
 
 
-#: What a plain solve of a cell did, by cell definition (see plain_solve).
+#: What the plain solves of a cell did, by cell definition (see plain_solve).
 _PLAIN_SOLVES: dict[str, str] = {}
 _PLAIN_LOCK = threading.Lock()
+#: Plain solves tried before a run that did not return is put down to the benchmark: a planner
+#: may hang in some solves and return in others of the same seed (OMPL 2.0.1's SORRTstar on the
+#: open square), and one plain solve that returned would blame the benchmark for the planner.
+PLAIN_TRIES = 3
 
 
 def plain_solve(task: RunTask) -> str:
     """What a plain ``ss.solve(task.time_limit)`` of ``task``'s problem and planner does in a fresh
-    process (no warm-up, no progress or memory thread), waited for ``task.hard_limit`` seconds:
-    ``"returns in 0.51 s"``, ``"does not return"`` or ``"ends its process (... killed by SIGSEGV)"``.
-    Found once per cell and sweep process."""
+    process (no warm-up, no progress or memory thread), each waited for ``task.hard_limit``
+    seconds, tried up to :data:`PLAIN_TRIES` times until one does not return or dies:
+    ``"returns in 0.51 s (each of 3 tries)"`` (the slowest), ``"does not return"`` or
+    ``"ends its process (... killed by SIGSEGV)"``. Found once per cell and sweep process."""
     with _PLAIN_LOCK:
         if task.definition in _PLAIN_SOLVES:
             return _PLAIN_SOLVES[task.definition]
+    slowest = 0.0
+    for _ in range(PLAIN_TRIES):
+        seconds = plain_solve_once(task)
+        if isinstance(seconds, str):
+            outcome = seconds
+            break
+        slowest = max(slowest, seconds)
+    else:
+        outcome = f"returns in {slowest:.2f} s (each of {PLAIN_TRIES} tries)"
+    with _PLAIN_LOCK:
+        _PLAIN_SOLVES[task.definition] = outcome
+    return outcome
+
+
+def plain_solve_once(task: RunTask) -> float | str:
+    """One plain solve of ``task`` (see :func:`plain_solve`): its seconds, or what happened instead
+    (``"does not return"``, ``"ends its process (...)"``)."""
     context = _context(_PRELOAD)
     receiver, sender = context.Pipe(duplex=False)
     process = context.Process(target=_plain_child, args=(task, sender), name=f"plain solve {task.key}")
     process.start()
     sender.close()
     try:
-        outcome = f"returns in {receiver.recv():.2f} s" if receiver.poll(task.hard_limit) else "does not return"
+        outcome: float | str = float(receiver.recv()) if receiver.poll(task.hard_limit) else "does not return"
     except EOFError:  # the process died before it could report
         process.join(1.0)
         outcome = f"ends its process ({_exit_text(process.exitcode)})"
@@ -152,8 +174,6 @@ def plain_solve(task: RunTask) -> str:
         if process.is_alive():
             process.kill()
         process.join()
-    with _PLAIN_LOCK:
-        _PLAIN_SOLVES[task.definition] = outcome
     return outcome
 
 
