@@ -99,6 +99,7 @@ def test_every_cached_kernel_of_the_package_uses_the_package_locator() -> None:
     assert len(cached) > 50
     for dispatcher in cached:
         assert isinstance(dispatcher._cache._impl.locator, PackageCacheLocator), dispatcher
+        assert isinstance(dispatcher._cache._cache_file, kernel_cache.LockedCacheFile), dispatcher
 
 
 def _imports_njit(text: str) -> bool:
@@ -162,3 +163,90 @@ def test_a_package_kernel_that_allocates_compiles_when_a_borrowing_kernel_calls_
     kernel, caller = _allocating_kernel_and_borrowing_caller(kernel_cache.njit)
     assert not kernel.overloads
     assert caller(4) == 4.0
+
+
+# One process's save or load of a package cache entry, started when the file ``go`` appears;
+# numba's steps slowed down where a second process could come in between.
+CACHE_ENTRY = """
+import sys, time
+from pathlib import Path
+from numba.core import caching
+from ompl_balance.core import kernel_cache
+
+folder, action, key, value, go, stamp = sys.argv[1:7]
+files = caching.IndexDataCacheFile  # (the class numba makes a cached function's files with)
+slow_index, slow_data = files._save_index, files._save_data
+
+def save_index(self, overloads):
+    time.sleep(0.5)  # (between reading the index and writing it back)
+    slow_index(self, overloads)
+    Path(folder, "indexed").touch()
+
+def save_data(self, name, data):
+    time.sleep(1.0)  # (between writing the index and the data)
+    slow_data(self, name, data)
+
+files._save_index, files._save_data = save_index, save_data
+source_stamp = ("source", kernel_cache.package_digest() if stamp == "package" else stamp)
+cache = files(folder, "f", source_stamp)
+while not Path(go).exists():
+    time.sleep(0.005)
+if action == "save":
+    cache.save(key, value)
+else:
+    while not Path(folder, "indexed").exists():
+        time.sleep(0.005)
+    print(cache.load(key))
+"""
+
+
+def _cache_entry(folder: Path, action: str, key: str, value: str = "", stamp: str = "package") -> subprocess.Popen:
+    go = folder / "go"
+    command = [sys.executable, "-c", CACHE_ENTRY, str(folder), action, key, value, str(go), stamp]
+    return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _finished(process: subprocess.Popen) -> str:
+    stdout, stderr = process.communicate(timeout=120)
+    assert process.returncode == 0, stderr
+    return stdout.strip()
+
+
+def _package_cache_file(folder: Path) -> Any:
+    from numba.core import caching
+
+    return caching.IndexDataCacheFile(str(folder), "f", ("source", kernel_cache.package_digest()))
+
+
+def test_two_processes_saving_entries_of_one_function_at_once_keep_both(tmp_path) -> None:
+    # (as the planning loop's specializations compiled in two processes: numba saves an entry by
+    # reading the index, adding it under the first free data file name and writing it back)
+    processes = [_cache_entry(tmp_path, "save", key, f"code of {key}") for key in ("a", "b")]
+    (tmp_path / "go").touch()
+    for process in processes:
+        _finished(process)
+    cache = _package_cache_file(tmp_path)
+    assert [cache.load("a"), cache.load("b")] == ["code of a", "code of b"]
+
+
+def test_a_load_during_a_save_never_reads_an_earlier_versions_data(tmp_path) -> None:
+    # an earlier version of the package left its entry under the first data file name
+    from numba.core import caching
+
+    caching.IndexDataCacheFile(str(tmp_path), "f", ("source", "an earlier digest")).save("a", "old code of a")
+    saving = _cache_entry(tmp_path, "save", "a", "code of a")
+    loading = _cache_entry(tmp_path, "load", "a")  # (once the save has written its index)
+    (tmp_path / "go").touch()
+    _finished(saving)
+    assert _finished(loading) == "code of a"
+
+
+def test_a_cached_function_outside_the_package_is_not_locked(tmp_path) -> None:
+    from numba.core import caching
+
+    cache = caching.IndexDataCacheFile(str(tmp_path), "f", ("source", "not the package's digest"))
+    cache.save("a", "code of a")
+    assert cache.load("a") == "code of a"
+    assert not list(tmp_path.glob("*.lock"))
+    _package_cache_file(tmp_path).save("a", "code of a")
+    assert [path.name for path in tmp_path.glob("*.lock")] == ["f.nbi.lock"]

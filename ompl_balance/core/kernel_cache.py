@@ -8,6 +8,10 @@ callee inside it, silently. Here every function defined in the package's files i
 with its file's stamp *and* a digest of all the package's Python sources: any change to the
 package compiles its kernels again (once, a minute or two), and no stale kernel ever runs.
 
+The package compiles kernels in parallel processes (specializations of one function, the planning
+loop, among them), which numba's cache does not guard against: the package's cache entries are
+saved and loaded under a lock the machine's processes share (:class:`LockedCacheFile`).
+
 The package's kernel modules take :func:`njit` from here rather than from numba: importing this
 module puts :class:`PackageCacheLocator` first among numba's cache locators before any of them
 is decorated (numba picks a function's locator when it is decorated).
@@ -15,6 +19,7 @@ is decorated (numba picks a function's locator when it is decorated).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 from collections.abc import Callable
@@ -24,7 +29,9 @@ from typing import Any, TypeVar, cast
 import numba
 from numba.core import caching
 
-__all__ = ["PackageCacheLocator", "cache_folder", "njit", "njit_borrowing", "package_digest"]
+from .file_lock import file_lock
+
+__all__ = ["LockedCacheFile", "PackageCacheLocator", "cache_folder", "njit", "njit_borrowing", "package_digest"]
 
 _Kernel = TypeVar("_Kernel", bound=Callable[..., Any])
 
@@ -124,3 +131,38 @@ _LOCATORS: list[Any] = (getattr(caching, "CacheImpl", None) or getattr(caching, 
 _NUMBAS_LOCATORS = [locator for locator in _LOCATORS if locator is not PackageCacheLocator]
 if PackageCacheLocator not in _LOCATORS:
     _LOCATORS.insert(0, PackageCacheLocator)
+
+
+class LockedCacheFile(caching.IndexDataCacheFile):
+    """numba's index and data files of a cached function; for the package's functions (their source
+    stamp is :class:`PackageCacheLocator`'s), saved and loaded under a lock beside the index.
+
+    numba saves an entry by reading the function's index, adding the entry under the first data
+    file name the index does not use, writing the index back, then the data; it loads by reading
+    the index, then the named data file, and does not check that the data is the entry's. So two
+    processes saving specializations of one function at once could keep one entry of the two and
+    write both compiled codes to one file, and a load between a save's index and its data could
+    read a data file of that name left by an earlier version of the package: the wrong machine
+    code for the arguments. Under the lock a save is whole before another save or a load starts
+    (loads share it: they only read).
+    """
+
+    def __init__(self, cache_path: str, filename_base: str, source_stamp: Any) -> None:
+        super().__init__(cache_path, filename_base, source_stamp)
+        package = isinstance(source_stamp, tuple) and len(source_stamp) == 2 and source_stamp[1] == package_digest()
+        self._lock_path = f"{self._index_path}.lock" if package else None
+
+    def save(self, key: Any, data: Any) -> None:
+        with self._locked(shared=False):
+            super().save(key, data)
+
+    def load(self, key: Any) -> Any:
+        with self._locked(shared=True):
+            return super().load(key)
+
+    def _locked(self, shared: bool) -> contextlib.AbstractContextManager[None]:
+        return contextlib.nullcontext() if self._lock_path is None else file_lock(self._lock_path, shared)
+
+
+# numba makes a cached function's files when the function is decorated, with the class of this name
+caching.IndexDataCacheFile = LockedCacheFile  # type: ignore[misc]

@@ -18,7 +18,7 @@ import pickle
 import subprocess
 import sys
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -27,6 +27,7 @@ from ompl import base as ob
 from ompl import util as ou
 
 from ..core.checks import kernel_modules
+from ..core.file_lock import file_lock
 from ..core.layout import SpaceLayout
 from ..core.spaces import ArrayPoints
 from ..core.trees import ArrayTree, Tree
@@ -92,22 +93,10 @@ def runs_compiled(checks: EngineChecks, engine: str) -> bool:
     return engine in ("auto", "compiled")
 
 
-@contextlib.contextmanager
-def _compile_lock(what: str) -> Iterator[None]:
-    """An exclusive lock on compiling ``what``, shared by the processes of the machine (where the
-    system has ``flock``)."""
-    try:
-        import fcntl
-    except ImportError:
-        yield
-        return
+def _compile_lock(what: str) -> contextlib.AbstractContextManager[None]:
+    """An exclusive lock on compiling ``what``, shared by the processes of the machine."""
     name = hashlib.sha256(what.encode()).hexdigest()[:16]
-    with open(Path(tempfile.gettempdir()) / f"ompl_balance-compile-{name}.lock", "a") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(lock, fcntl.LOCK_UN)
+    return file_lock(Path(tempfile.gettempdir()) / f"ompl_balance-compile-{name}.lock")
 
 
 class CompiledEngine:
