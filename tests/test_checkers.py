@@ -465,6 +465,117 @@ def test_setup_checker_refuses_what_it_cannot_take():
     discrete = ob.DiscreteStateSpace(0, 5)
     with pytest.raises(ValueError, match="no flat layout"):
         setup_checker(ob.SpaceInformation(discrete), python_free)
+    # a space whose real-vector part has no bounds, though its extent is positive (its SO(2) part)
+    with pytest.raises(ValueError, match="bounds are not set"):
+        setup_checker(ob.SpaceInformation(ob.SE2StateSpace()), python_free)
+    # a space OMPL gives no maximum extent
+    with pytest.raises(ValueError, match="TimeStateSpace has no flat layout"):
+        setup_checker(ob.SpaceInformation(ob.TimeStateSpace()), python_free)
+
+
+def test_a_numba_function_compiled_for_its_own_signature_is_taken_and_a_cfunc_named_as_written():
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    si = ob.SpaceInformation(space)
+    for signature in ("boolean(float64[::1])", "boolean(float64[:])"):
+        eager = numba.njit(signature)(numba_free.py_func)
+        checker, _ = setup_checker(si, eager)
+        assert [checker.function.check(np.array(point)) for point in ((0.22, 0.5), (0.1, 0.5))] == [False, True]
+    with pytest.raises(TypeError, match=r"compiled for its own signatures only \(\(int64,\) -> bool\)"):
+        setup_checker(si, numba.njit("boolean(int64)")(lambda q: q > 0))
+
+    @numba.cfunc(numba.types.float64(numba.types.CPointer(numba.types.float64), numba.types.intp))
+    def misdeclared(values, dim):
+        return 1.0
+
+    with pytest.raises(TypeError, match="has signature") as refused:
+        setup_checker(si, misdeclared)
+    assert "misdeclared has signature" in str(refused.value) and "numba.core" not in str(refused.value)
+
+
+@numba.njit(cache=True)
+def writes_into_its_state(q):
+    free = numba_free(q)
+    q[0] = 0.22  # (inside the first wall)
+    q[1] = 0.5
+    return free
+
+
+@pytest.mark.parametrize("engine", ["compiled", "python"])
+def test_a_function_that_writes_into_its_state_leaves_the_planners_states_alone(engine):
+    """A numba function is given a copy of the state on the compiled engine, as it is elsewhere:
+    the path, checked again with the function that does not write, is the same as the Python
+    engine's and valid."""
+    ss = square(writes_into_its_state)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.params().setParam("engine", engine)
+    planner.params().setParam("seed", "3")
+    ss.setPlanner(planner)
+    assert ss.solve(10.0)
+    path = ss.getSolutionPath()
+    points = [(path.getState(i)[0], path.getState(i)[1]) for i in range(path.getStateCount())]
+    assert all(python_free(point) for point in points)
+    assert (0.22, 0.5) not in points
+    other = square(numba_free)
+    reference = BalancedRRTConnect(other.getSpaceInformation())
+    reference.params().setParam("engine", "python")
+    reference.params().setParam("seed", "3")
+    other.setPlanner(reference)
+    assert other.solve(10.0)
+    again = other.getSolutionPath()
+    assert points == [(again.getState(i)[0], again.getState(i)[1]) for i in range(again.getStateCount())]
+
+
+def wall_at_the_middle(state) -> bool:
+    return not (0.45 < state[0] < 0.55 and state[1] < 0.9)
+
+
+@pytest.mark.parametrize("planner", ["stock", "python", "compiled"])
+def test_a_checker_set_after_setup_checker_decides_the_motions_too(planner):
+    """setup_checker(ss, f), then ss.setStateValidityChecker(g): motions are checked with g by
+    OMPL's discrete rule (OMPL's own validator is the oracle), by stock planners and both engines,
+    and counted once each."""
+    ss = square(lambda q: True)  # everything free: its motion validator would let any path through
+    ss.setStateValidityChecker(wall_at_the_middle)
+    si = ss.getSpaceInformation()
+    si.setStateValidityCheckingResolution(0.01)
+    if planner == "stock":
+        made = og.RRTConnect(si)
+    else:
+        made = BalancedRRTConnect(si)
+        made.params().setParam("engine", planner)
+    ss.setPlanner(made)
+    assert ss.solve(10.0)
+    reference, _ = ompl_reference(wall_at_the_middle)
+    path = ss.getSolutionPath()
+    a, b = reference.allocState(), reference.allocState()
+    for i in range(path.getStateCount() - 1):
+        a[0], a[1] = path.getState(i)[0], path.getState(i)[1]
+        b[0], b[1] = path.getState(i + 1)[0], path.getState(i + 1)[1]
+        assert reference.checkMotion(a, b), i
+    if planner != "stock":
+        assert made.stats.motions_checked > 0
+        assert made.stats.states_checked >= made.stats.motions_checked
+    # the validator's own answers, from Python, against OMPL's on random motions
+    validator = si.getMotionValidator()
+    rng = np.random.default_rng(2)
+    s1, s2 = si.allocState(), si.allocState()
+    for _ in range(100):
+        p, q = rng.random(2), rng.random(2)
+        s1[0], s1[1], s2[0], s2[1] = a[0], a[1], b[0], b[1] = *p, *q
+        assert validator.checkMotion(s1, s2) == reference.checkMotion(a, b)
+        valid, fraction = validator.check_motion_last_valid(s1, s2)
+        assert valid == reference.checkMotion(a, b)
+        if not valid:  # the last valid state by OMPL's rule from s1 (brute force)
+            n = si.getStateSpace().validSegmentCount(s1, s2)
+            between = si.allocState()
+            first = next(j for j in range(1, n + 1) if not _valid_at(si, s1, s2, j / n, between))
+            assert fraction == pytest.approx((first - 1) / n)
+
+
+def _valid_at(si, s1, s2, t, state) -> bool:
+    si.getStateSpace().interpolate(s1, s2, t, state)
+    return wall_at_the_middle(state)
 
 
 @pytest.mark.parametrize(

@@ -79,7 +79,8 @@ def setup_checker(
     """
     si = space_information(target)
     function = CheckFunction(fn, layout_dimension(si), vectorized)
-    checker, validator = FunctionValidityChecker(si, function), FunctionMotionValidator(si, function)
+    checker = FunctionValidityChecker(si, function)
+    validator = FunctionMotionValidator(si, function, checker)
     si.setStateValidityChecker(checker)
     si.setMotionValidator(validator)
     return checker, validator

@@ -11,7 +11,6 @@ gets the answers OMPL's ``DiscreteMotionValidator`` would give, and the work cou
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
@@ -20,6 +19,7 @@ from ompl import base as ob
 
 from ..core.checks import Count, load_kernels
 from ..core.compiled_calls import entry_point
+from ..core.discrete_motion_kernels import bisection_order
 from ..core.discrete_motions import DiscreteMotions, discrete_motions
 from ..core.exit_checks import ExitChecks, exit_checks
 from ..core.layout import SpaceLayout, interpolate, layout_for, state_reader
@@ -45,7 +45,7 @@ class FunctionValidityChecker(ob.StateValidityChecker):
         function = self.function
         if not function.address:
             return None
-        return FunctionStates(function.address, function.failed, function.counts)
+        return function.states_view()
 
     def counters(self) -> dict[str, int]:
         """States and motions checked (shared with the motion validator)."""
@@ -72,11 +72,25 @@ class FunctionMotionValidator(ob.MotionValidator):
     tests the states from ``s1`` outwards and reports the fraction of the last valid one. (OMPL
     2.0's bindings hand C++ callers of that overload the plain ``checkMotion`` of a Python
     validator, without ``lastValid``; Python callers have this method.)
+
+    Once the space information's state validity checker is no longer ``checker`` (a later
+    ``ss.setStateValidityChecker``), the validator checks motions as OMPL's
+    ``DiscreteMotionValidator`` does, with the checker the space information has (``si.isValid``),
+    as planners and the compiled engine do: OMPL 2.0's bindings offer no way to put OMPL's own
+    validator back.
     """
 
-    def __init__(self, si: ob.SpaceInformation, function: CheckFunction) -> None:
+    #: Once it no longer follows the function (see above), the compiled engine checks its motions
+    #: with the space information's checker by OMPL's discrete rule.
+    checks_as_discrete = True
+
+    def __init__(self, si: ob.SpaceInformation, function: CheckFunction, checker: FunctionValidityChecker) -> None:
         super().__init__(si)
         self.function = function
+        self._si = si  # (to tell whether its state validity checker is still ``checker``)
+        self._checker = checker
+        self._rule_motions = 0  # motions checked with a later checker (see above), from Python
+        self._between = si.allocState()  # (scratch: a state between a motion's ends)
         self._space = si.getStateSpace()
         self._read = state_reader(self._space)
         self._view: DiscreteMotions | ExitChecks | None = None
@@ -85,8 +99,14 @@ class FunctionMotionValidator(ob.MotionValidator):
         # the motion kernel compiled (or loaded from numba's cache) now, not in a planner's first check
         self._motion_free: Callable[..., bool] = self._kernel(self._make_view(1.0))
 
+    def follows_function(self) -> bool:
+        """Whether the space information's state validity checker is still the function's."""
+        return self._si.getStateValidityChecker() is self._checker
+
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
-        view = self.compiled_view()
+        if not self.follows_function():
+            return self._by_rule(s1, s2, from_start=False)[0]
+        view = self._function_view()
         a, b = np.array(self._read(s1)), np.array(self._read(s2))
         free = self._motion_free(view, a, b)
         if self.function.counts[Count.RAISED]:
@@ -97,7 +117,9 @@ class FunctionMotionValidator(ob.MotionValidator):
         """``(valid, fraction)``: whether the motion ``s1 -> s2`` is valid, and where its last valid
         state lies (OMPL's ``lastValid.second``: ``(j - 1) / n`` when the state ``j / n`` is the
         first invalid one from ``s1``, ``(n - 1) / n`` when only ``s2`` is; 1.0 for a valid motion)."""
-        self.compiled_view()  # (the layout for the space's current resolution)
+        if not self.follows_function():
+            return self._by_rule(s1, s2, from_start=True)
+        self._function_view()  # (the layout for the space's current resolution)
         layout = self._layout
         assert layout is not None
         a, b = np.array(self._read(s1)), np.array(self._read(s2))
@@ -107,10 +129,38 @@ class FunctionMotionValidator(ob.MotionValidator):
         first = self.function.first_invalid(states)
         return (True, 1.0) if first == len(states) else (False, first / n)
 
-    def compiled_view(self) -> DiscreteMotions | ExitChecks:
+    def compiled_view(self) -> DiscreteMotions | ExitChecks | None:
         """The validator as compiled code calls it, for the space's current resolution: OMPL's
         discrete rule around the function's compiled form, or around one call into Python per
-        motion (:class:`~ompl_balance.core.exit_checks.ExitChecks`)."""
+        motion (:class:`~ompl_balance.core.exit_checks.ExitChecks`); ``None`` once it no longer
+        follows the function (the engine then checks by the rule with the current checker)."""
+        return self._function_view() if self.follows_function() else None
+
+    def _by_rule(self, s1: ob.State, s2: ob.State, from_start: bool) -> tuple[bool, float]:
+        """OMPL's ``DiscreteMotionValidator`` with the space information's current checker:
+        ``(valid, fraction of the last valid state)``. ``from_start`` (its ``lastValid`` overload):
+        the states ``j / n`` from ``s1`` outwards; otherwise ``s2``, then those between in the
+        rule's bisection order."""
+        si, space = self._si, self._space
+        self._rule_motions += 1
+        n = max(space.validSegmentCount(s1, s2), 1)
+        if from_start:
+            fractions = [j / n for j in range(1, n + 1)]
+        else:
+            if not si.isValid(s2):
+                return False, 1.0
+            queue, order = np.empty((n, 2), dtype=np.int64), np.empty(n, dtype=np.int64)
+            bisection_order(n, queue, order)
+            fractions = [j / n for j in order[: n - 1].tolist()]
+        state = self._between
+        for fraction in fractions:
+            space.interpolate(s1, s2, fraction, state)
+            if not si.isValid(state):
+                return False, fraction - 1.0 / n
+        return True, 1.0
+
+    def _function_view(self) -> DiscreteMotions | ExitChecks:
+        """The function's view for the space's current resolution (see :meth:`compiled_view`)."""
         space = self._space
         measures = (space.getMaximumExtent(), space.getLongestValidSegmentLength(), space.getValidSegmentCountFactor())
         if self._view is None or measures != self._made_for:
@@ -124,7 +174,7 @@ class FunctionMotionValidator(ob.MotionValidator):
         self._layout = layout
         function = self.function
         if function.address:
-            states = FunctionStates(function.address, function.failed, function.counts)
+            states = function.states_view()
             return discrete_motions(states, layout, extent)
         view = exit_checks(function, layout, extent, function.counts, batched=True)
         function.rows = view.rows
@@ -143,11 +193,18 @@ class FunctionMotionValidator(ob.MotionValidator):
         return entry_point(kernel, (view, a, a))
 
     def counters(self) -> dict[str, int]:
-        """States and motions checked (shared with the validity checker)."""
-        return _counters(self.function)
+        """States and motions checked (shared with the validity checker); once it no longer
+        follows the function, the motions only (its own and those compiled code checked with the
+        current checker, which counts its states)."""
+        if self.follows_function():
+            return _counters(self.function)
+        checker = self._si.getStateValidityChecker()
+        counted = checker.counters().get("motions_checked", 0) if hasattr(checker, "counters") else 0
+        return {"motions_checked": self._rule_motions + counted}
 
     def reset_counters(self) -> None:
         self.function.counts[:] = 0
+        self._rule_motions = 0
 
     def raise_error(self) -> None:
         """Raise the error the function met in compiled code."""
@@ -174,23 +231,22 @@ def space_information(target: Any) -> ob.SpaceInformation:
 
 
 def layout_dimension(si: ob.SpaceInformation) -> int:
-    """Reals in a state of ``si``'s space (its flat layout); a one-line error for a space without one."""
-    space = si.getStateSpace()
-    layout = layout_for(space) if _has_bounds(space) else None
-    if layout is None:
-        from ..core.layout import has_layout
+    """Reals in a state of ``si``'s space (its flat layout); a one-line error for a space without
+    one or with a real-vector part whose bounds are not set."""
+    from ..core.layout import has_layout
 
-        if has_layout(space):
-            raise ValueError(f"setup_checker: the {type(space).__name__}'s bounds are not set (call setBounds first)")
+    space = si.getStateSpace()
+    if not has_layout(space):
         raise ValueError(
             f"setup_checker: a {type(space).__name__} has no flat layout; setup_checker takes real-vector, SO(2), "
             "SO(3), SE(2), SE(3) spaces and compounds of them"
         )
+    layout = layout_for(space)
+    assert layout is not None  # (has_layout)
+    low, high = layout.low, layout.high
+    if not (np.isfinite(low).all() and np.isfinite(high).all() and (low < high).all()):
+        raise ValueError(
+            f"setup_checker: the {type(space).__name__}'s bounds are not set (call setBounds on its real-vector "
+            "part first)"
+        )
     return int(layout.dim)
-
-
-def _has_bounds(space: ob.StateSpace) -> bool:
-    try:
-        return math.isfinite(space.getMaximumExtent()) and space.getMaximumExtent() > 0.0
-    except RuntimeError:
-        return False

@@ -34,6 +34,7 @@ import numpy as np
 
 from ..core.checks import Count
 from ..core.exit_checks import Query, row_chunks
+from .views import FunctionStates
 
 #: The kinds of function (see the module docstring).
 KINDS = ("numba", "cfunc", "vectorized", "python")
@@ -48,7 +49,7 @@ class CheckerError(RuntimeError):
 
 def describe(function: Any) -> str:
     """A function's name as messages give it (``module.qualname``)."""
-    target = getattr(function, "py_func", function)
+    target = getattr(function, "py_func", None) or getattr(function, "__wrapped__", None) or function  # (njit; cfunc)
     name = getattr(target, "__qualname__", None) or type(function).__name__
     module = getattr(target, "__module__", None)
     return name if module in (None, "__main__", "builtins") else f"{module}.{name}"
@@ -110,6 +111,10 @@ class CheckFunction:
             _check_arity(function, self.name)
         if self.address:
             self._c_check = _C_CHECK(self.address)
+
+    def states_view(self) -> FunctionStates:
+        """The function as compiled code calls it (``numba`` and ``cfunc`` kinds: ``address`` set)."""
+        return FunctionStates(self.address, np.empty(self.dim), self.failed, self.counts)
 
     # -- from Python: one state, a motion's states ------------------------------------------------
 
@@ -272,10 +277,12 @@ def _compile_wrapper(function: Any, name: str) -> Any:
     array = types.Array(types.float64, 1, "C")
     try:
         function.compile((array,))
+        return_type = function.overloads[(array,)].signature.return_type
     except NumbaError as error:
         first_line = str(error).strip().splitlines()[0]
         raise TypeError(f"setup_checker: numba cannot compile {name} for a float64 array: {first_line}") from None
-    return_type = function.overloads[(array,)].signature.return_type
+    except RuntimeError:  # numba compiles it for the signatures it was given only (njit with a signature)
+        return_type = _given_signature(function, name, array).return_type
     if not isinstance(return_type, types.Boolean):
         raise TypeError(f"setup_checker: {name} returns {return_type}; a validity function returns a bool")
 
@@ -288,6 +295,23 @@ def _compile_wrapper(function: Any, name: str) -> Any:
             return -1
 
     return check
+
+
+def _given_signature(function: Any, name: str, array: Any) -> Any:
+    """The signature, among those ``function`` was compiled for (``njit`` given signatures), that a
+    C-contiguous 1-D float64 ``array`` can be passed to; a one-line error when there is none."""
+    from numba import types
+
+    for args, compiled in function.overloads.items():
+        if len(args) == 1 and isinstance(args[0], types.Array):
+            given = args[0]
+            if given.dtype == array.dtype and given.ndim == 1 and given.layout in ("C", "A"):
+                return compiled.signature
+    signatures = ", ".join(str(compiled.signature) for compiled in function.overloads.values()) or "none"
+    raise TypeError(
+        f"setup_checker: {name} is compiled for its own signatures only ({signatures}); a validity function "
+        "takes a 1-D float64 array (float64[::1] or float64[:])"
+    )
 
 
 def _short(value: Any) -> str:

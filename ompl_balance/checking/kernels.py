@@ -13,12 +13,15 @@ from .views import FunctionStates
 
 @njit(cache=True, inline="always")
 def function_state_free(view: FunctionStates, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
-    """Whether ``q`` is valid for the function at ``view.address``; counts one state. A function
-    that raised answers "not valid", its state kept in ``view.failed`` and the RAISED flag set.
-    (The view's fields read once, first: see :func:`~ompl_balance.worlds.box_kernels.box_state_free`.)"""
-    address, failed, counts = view.address, view.failed, view.counts
+    """Whether ``q`` is valid for the function at ``view.address``, which is given a copy of it;
+    counts one state. A function that raised answers "not valid", its state kept in
+    ``view.failed`` and the RAISED flag set. (The view's fields read once, first: see
+    :func:`~ompl_balance.worlds.box_kernels.box_state_free`.)"""
+    address, given, failed, counts = view.address, view.given, view.failed, view.counts
     counts[Count.STATES] += 1
-    answer = call_state_function(address, q)
+    for i in range(q.shape[0]):
+        given[i] = q[i]
+    answer = call_state_function(address, given)
     if answer == 1:
         return True
     if answer < 0:

@@ -19,8 +19,11 @@ from ..core.checks import kernels_in
 @kernels_in("ompl_balance.checking.kernels")
 class FunctionStates(NamedTuple):
     """A compiled validity function at ``address`` (``int8 check(const double *q, intptr_t dim)``),
-    ``failed`` (dim,) the state at which it raised, ``counts`` the work counter."""
+    ``given`` (dim,) the copy of a state the function is given (a function that writes into its
+    ``q`` changes the copy, not the planner's state), ``failed`` (dim,) the state at which it
+    raised, ``counts`` the work counter."""
 
     address: int
+    given: np.ndarray
     failed: np.ndarray
     counts: np.ndarray
