@@ -22,6 +22,7 @@ from ..core.compiled_calls import entry_point
 from ..core.discrete_motion_kernels import bisection_order
 from ..core.discrete_motions import DiscreteMotions, discrete_motions
 from ..core.exit_checks import ExitChecks, exit_checks
+from ..core.exit_release import release_at_exit
 from ..core.layout import SpaceLayout, interpolate, layout_for, state_reader
 from .functions import CheckFunction
 from .views import FunctionStates
@@ -34,6 +35,7 @@ class FunctionValidityChecker(ob.StateValidityChecker):
         super().__init__(si)
         self.function = function
         self._read = state_reader(si.getStateSpace())
+        release_at_exit(self)  # (it holds the user's function: see core.exit_release)
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         self.function.counts[Count.STATES] += 1
@@ -73,11 +75,12 @@ class FunctionMotionValidator(ob.MotionValidator):
     2.0's bindings hand C++ callers of that overload the plain ``checkMotion`` of a Python
     validator, without ``lastValid``; Python callers have this method.)
 
-    Once the space information's state validity checker is no longer ``checker`` (a later
-    ``ss.setStateValidityChecker``), the validator checks motions as OMPL's
-    ``DiscreteMotionValidator`` does, with the checker the space information has (``si.isValid``),
-    as planners and the compiled engine do: OMPL 2.0's bindings offer no way to put OMPL's own
-    validator back.
+    Told that the space information's state validity checker is no longer ``checker`` (a later
+    ``ss.setStateValidityChecker``; the package's planners tell it at each solve,
+    :meth:`follow_checker`), it checks motions as OMPL's ``DiscreteMotionValidator`` does, with
+    the checker the space information has: OMPL 2.0's bindings offer no way to put OMPL's own
+    validator back. (It cannot ask the space information itself: an object OMPL holds from C++
+    that holds its space information is never freed.)
     """
 
     #: Once it no longer follows the function (see above), the compiled engine checks its motions
@@ -87,11 +90,13 @@ class FunctionMotionValidator(ob.MotionValidator):
     def __init__(self, si: ob.SpaceInformation, function: CheckFunction, checker: FunctionValidityChecker) -> None:
         super().__init__(si)
         self.function = function
-        self._si = si  # (to tell whether its state validity checker is still ``checker``)
         self._checker = checker
-        self._rule_motions = 0  # motions checked with a later checker (see above), from Python
-        self._between = si.allocState()  # (scratch: a state between a motion's ends)
+        self._current: ob.StateValidityChecker | None = None  # the space's checker, once not ``checker``
+        self._rule_motions = 0  # motions checked with ``_current`` from Python
         self._space = si.getStateSpace()
+        # (scratch: a state between a motion's ends; the space's, as one of si's would hold si)
+        self._between = self._space.allocState()
+        release_at_exit(self)  # (it holds the user's function: see core.exit_release)
         self._read = state_reader(self._space)
         self._view: DiscreteMotions | ExitChecks | None = None
         self._made_for: tuple[float, float, int] | None = None  # the space measures _view is for
@@ -99,9 +104,14 @@ class FunctionMotionValidator(ob.MotionValidator):
         # the motion kernel compiled (or loaded from numba's cache) now, not in a planner's first check
         self._motion_free: Callable[..., bool] = self._kernel(self._make_view(1.0))
 
+    def follow_checker(self, checker: ob.StateValidityChecker) -> None:
+        """Check motions with ``checker``, the space information's state validity checker now: with
+        the function while it is the function's checker, else by OMPL's discrete rule with it."""
+        self._current = None if checker is self._checker else checker
+
     def follows_function(self) -> bool:
-        """Whether the space information's state validity checker is still the function's."""
-        return self._si.getStateValidityChecker() is self._checker
+        """Whether motions are checked with the function (see :meth:`follow_checker`)."""
+        return self._current is None
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         if not self.follows_function():
@@ -141,13 +151,14 @@ class FunctionMotionValidator(ob.MotionValidator):
         ``(valid, fraction of the last valid state)``. ``from_start`` (its ``lastValid`` overload):
         the states ``j / n`` from ``s1`` outwards; otherwise ``s2``, then those between in the
         rule's bisection order."""
-        si, space = self._si, self._space
+        checker, space = self._current, self._space
+        assert checker is not None  # (not following the function)
         self._rule_motions += 1
         n = max(space.validSegmentCount(s1, s2), 1)
         if from_start:
             fractions = [j / n for j in range(1, n + 1)]
         else:
-            if not si.isValid(s2):
+            if not checker.isValid(s2):
                 return False, 1.0
             queue, order = np.empty((n, 2), dtype=np.int64), np.empty(n, dtype=np.int64)
             bisection_order(n, queue, order)
@@ -155,7 +166,7 @@ class FunctionMotionValidator(ob.MotionValidator):
         state = self._between
         for fraction in fractions:
             space.interpolate(s1, s2, fraction, state)
-            if not si.isValid(state):
+            if not checker.isValid(state):
                 return False, fraction - 1.0 / n
         return True, 1.0
 
@@ -196,9 +207,9 @@ class FunctionMotionValidator(ob.MotionValidator):
         """States and motions checked (shared with the validity checker); once it no longer
         follows the function, the motions only (its own and those compiled code checked with the
         current checker, which counts its states)."""
-        if self.follows_function():
+        checker = self._current
+        if checker is None:  # (following the function)
             return _counters(self.function)
-        checker = self._si.getStateValidityChecker()
         counted = checker.counters().get("motions_checked", 0) if hasattr(checker, "counters") else 0
         return {"motions_checked": self._rule_motions + counted}
 

@@ -35,6 +35,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from .checks import Count, new_counts
+from .exit_release import release_at_exit
 
 
 class CountingValidityChecker(ob.StateValidityChecker):
@@ -66,6 +67,7 @@ class CountingValidityChecker(ob.StateValidityChecker):
         self.states_checked = 0  # by isValid; compiled code counts in self.counts
         self.counts = new_counts()
         self._view: Any = None
+        release_at_exit(self)  # (it holds the user's function: see core.exit_release)
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL's name)
         self.states_checked += 1
@@ -138,6 +140,15 @@ def ensure_counting(si: ob.SpaceInformation) -> None:
     if not hasattr(checker, "counters"):
         function = installed_function(si, checker)
         si.setStateValidityChecker(CountingValidityChecker(si, checker if function is None else function))
+
+
+def tell_validator_the_checker(si: ob.SpaceInformation) -> None:
+    """Tell ``si``'s motion validator, where it checks states with a checker of its own
+    (``follow_checker``: :func:`~ompl_balance.checking.setup_checker`'s), which state validity
+    checker ``si`` has now, so that a checker set since decides the motions too."""
+    follow_checker = getattr(si.getMotionValidator(), "follow_checker", None)
+    if follow_checker is not None:
+        follow_checker(si.getStateValidityChecker())
 
 
 #: Frames above the caller of :func:`installed_function` in which a ``SimpleSetup`` is looked for.

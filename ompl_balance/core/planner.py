@@ -40,7 +40,8 @@ from ompl import control as oc
 from ompl import geometric as og
 from ompl import util as ou
 
-from .counting import WorkCount, ensure_counting, read_work
+from .counting import WorkCount, ensure_counting, read_work, tell_validator_the_checker
+from .exit_release import release_at_exit
 from .params import ParamSet, Settings, add_accessors
 from .spaces import Points, points_for
 from .trees import NO_PARENT, Tree
@@ -229,6 +230,7 @@ class TreePlanner(ob.Planner):
         self._points: Points | None = None  # how solves see the space (made at setup)
         self.progress = Progress()
         self.stats: Any = None
+        release_at_exit(self)  # (OMPL holds planners from C++: see core.exit_release)
 
     @classmethod
     def _refuse_argument(cls, problem: str, value: Any) -> None:
@@ -312,6 +314,7 @@ class TreePlanner(ob.Planner):
         self.checkValidity()
         self._before_solve(ptc)
         si = self.getSpaceInformation()
+        tell_validator_the_checker(si)
         began = time.perf_counter()
         work_before = read_work(si)
         rng = self._generator()
