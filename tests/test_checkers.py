@@ -789,3 +789,53 @@ def test_a_script_with_setup_checker_ends_without_nanobinds_leak_report(tmp_path
         )
     assert done.returncode == 0 and done.stdout.strip().endswith("True"), done.stderr[-2000:]
     assert "leaked" not in done.stderr, done.stderr[-2000:]
+
+
+def _thin_wall(q) -> bool:
+    return not (0.5031 < q[0] < 0.5069)  # (0.0038 thick: between the states of a coarse check)
+
+
+def _line_and_angle():
+    """A compound of a unit segment and an angle, with setup_checker's thin wall across the segment."""
+    space = ob.CompoundStateSpace()
+    line = ob.RealVectorStateSpace(1)
+    line.setBounds(0.0, 1.0)
+    space.addSubspace(line, 1.0)
+    space.addSubspace(ob.SO2StateSpace(), 1.0)
+    ss = og.SimpleSetup(space)
+    setup_checker(ss, _thin_wall)
+    start, goal = space.allocState(), space.allocState()
+    start[0][0], start[1].value, goal[0][0], goal[1].value = 0.1, 0.0, 0.9, 0.0
+    ss.setStartAndGoalStates(start, goal)
+    return ss, line
+
+
+@pytest.mark.parametrize("engine", ["python", "compiled"])
+def test_a_subspaces_resolution_changed_after_use_is_the_one_motions_are_checked_at(engine):
+    """A subspace's longest valid segment refined after the validator and a planner were used: the
+    validator answers as OMPL's own validator with the same test on random motions, and the
+    planner no longer crosses a wall the coarse resolution stepped over."""
+    ss, line = _line_and_angle()
+    si = ss.getSpaceInformation()
+    planner = BalancedRRTConnect(si)
+    planner.params().setParam("engine", engine)
+    ss.setPlanner(planner)
+    assert ss.solve(5.0)  # (through the wall: its states fall between those the rule tests)
+    line.setLongestValidSegmentFraction(0.0005)
+    si.setup()
+    reference = ob.SpaceInformation(si.getStateSpace())
+    reference.setStateValidityChecker(lambda state: _thin_wall([state[0][0]]))
+    reference.setup()
+    validator, space = si.getMotionValidator(), si.getStateSpace()
+    a, b = space.allocState(), space.allocState()
+    rng = np.random.default_rng(7)
+    answers = []
+    for _ in range(60):
+        a[0][0], a[1].value, b[0][0], b[1].value = rng.random(), 0.0, rng.random(), 0.0
+        answers.append(validator.checkMotion(a, b))
+        assert answers[-1] == reference.checkMotion(a, b)
+    assert 0 < sum(answers) < len(answers)
+    planner.clear()
+    ss.getProblemDefinition().clearSolutionPaths()
+    ss.solve(0.5)
+    assert not ss.haveExactSolutionPath()

@@ -23,7 +23,7 @@ from ..core.discrete_motion_kernels import bisection_order
 from ..core.discrete_motions import DiscreteMotions, discrete_motions
 from ..core.exit_checks import ExitChecks, exit_checks
 from ..core.exit_release import release_at_exit
-from ..core.layout import SpaceLayout, interpolate, layout_for, state_reader
+from ..core.layout import SpaceLayout, interpolate, layout_for, leaf_spaces, resolution_measures, state_reader
 from .functions import CheckFunction
 from .views import FunctionStates
 
@@ -99,7 +99,8 @@ class FunctionMotionValidator(ob.MotionValidator):
         release_at_exit(self)  # (it holds the user's function: see core.exit_release)
         self._read = state_reader(self._space)
         self._view: DiscreteMotions | ExitChecks | None = None
-        self._made_for: tuple[float, float, int] | None = None  # the space measures _view is for
+        self._leaves = leaf_spaces(self._space)
+        self._made_for: tuple[float, ...] | None = None  # the space's resolution_measures _view is for
         self._layout: SpaceLayout | None = None
         # the motion kernel compiled (or loaded from numba's cache) now, not in a planner's first check
         self._motion_free: Callable[..., bool] = self._kernel(self._make_view(1.0))
@@ -172,8 +173,7 @@ class FunctionMotionValidator(ob.MotionValidator):
 
     def _function_view(self) -> DiscreteMotions | ExitChecks:
         """The function's view for the space's current resolution (see :meth:`compiled_view`)."""
-        space = self._space
-        measures = (space.getMaximumExtent(), space.getLongestValidSegmentLength(), space.getValidSegmentCountFactor())
+        measures = resolution_measures(self._space, self._leaves)
         if self._view is None or measures != self._made_for:
             self._view, self._made_for = self._make_view(measures[0]), measures
         return self._view

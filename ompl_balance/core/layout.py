@@ -87,6 +87,23 @@ class SpaceLayout(NamedTuple):
         return len(self.kind) == 1 and self.kind.item(0) == Leaf.REAL and self.weight.item(0) == 1.0
 
 
+def leaf_spaces(space: ob.StateSpace) -> list[ob.StateSpace]:
+    """The leaves of ``space`` in layout order (``[]`` for a space without a flat layout)."""
+    leaves: list[tuple[Leaf, float, ob.StateSpace]] = []
+    return [leaf for _, _, leaf in leaves] if _leaves(space, 1.0, leaves) else []
+
+
+def resolution_measures(space: ob.StateSpace, leaves: list[ob.StateSpace]) -> tuple[float, ...]:
+    """What a layout of ``space`` (its leaves ``leaves``, :func:`leaf_spaces`) depends on that a
+    change of its bounds or validity-checking resolution changes, cheap to read: its maximum
+    extent, and the longest valid segment and segment-count factor of it and of each leaf (a
+    leaf's resolution can change alone: ``setLongestValidSegmentFraction`` on a subspace)."""
+    measures = [space.getMaximumExtent(), space.getLongestValidSegmentLength(), space.getValidSegmentCountFactor()]
+    for leaf in leaves:
+        measures += (leaf.getLongestValidSegmentLength(), leaf.getValidSegmentCountFactor())
+    return tuple(measures)
+
+
 def _leaves(space: ob.StateSpace, weight: float, out: list[tuple[Leaf, float, ob.StateSpace]]) -> bool:
     """Append ``space``'s leaves (kind, weight, leaf space) to ``out``; ``False`` for a space without a flat layout."""
     kind = type(space)

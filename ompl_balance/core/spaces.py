@@ -27,7 +27,7 @@ import numpy as np
 from ompl import base as ob
 
 from . import layout as flat
-from .layout import SpaceLayout, layout_for, state_reader
+from .layout import SpaceLayout, layout_for, leaf_spaces, resolution_measures, state_reader
 from .trees import ArrayTree, StateTree, Tree
 
 #: Uniform samples drawn from numpy at a time (the compiled engine draws the same blocks).
@@ -67,14 +67,15 @@ class ArrayPoints:
         self._read = state_reader(self._space)
         # Two scratch OMPL states: checks take a pair (nearest, new) at a time.
         self._scratch = (si.allocState(), si.allocState())
-        self._space_measures = _layout_measures(self._space)
+        self._leaves = leaf_spaces(self._space)
+        self._space_measures = resolution_measures(self._space, self._leaves)
         self._largest = max(float(np.abs(layout.low).max(initial=0.0)), float(np.abs(layout.high).max(initial=0.0)))
 
     def restarted(self, rng: np.random.Generator) -> Points:
         """These points, drawing from ``rng`` from now on (a fresh block of samples), for the next
         solve; new points when the space's extent or validity-checking resolution changed since
         these were made (a ``si.setup()`` after a change), so that the layout is the space's own."""
-        if _layout_measures(self._space) != self._space_measures:
+        if resolution_measures(self._space, self._leaves) != self._space_measures:
             return points_for(self._si, rng)
         self._rng = rng
         self._block = self._block[:0]
@@ -225,11 +226,6 @@ class StatePoints:
         """As :meth:`RealVectorPoints.segment_points`: the states a motion check of ``(a, b)`` decided."""
         count = self._space.validSegmentCount(a, b)
         return [self.interpolate(a, b, step / count) for step in range(1, count)] + [self.new_state(b)]
-
-
-def _layout_measures(space: ob.StateSpace) -> tuple[float, float]:
-    """What a change of a space's bounds or validity-checking resolution changes (cheap to read)."""
-    return space.getMaximumExtent(), space.getLongestValidSegmentLength()
 
 
 def points_for(si: ob.SpaceInformation, rng: np.random.Generator | None = None) -> Points:
