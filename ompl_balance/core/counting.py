@@ -139,6 +139,10 @@ def ensure_counting(si: ob.SpaceInformation) -> None:
         raise ValueError("the space information has no state validity checker; call si.setStateValidityChecker first")
     if not hasattr(checker, "counters"):
         function = installed_function(si, checker)
+        # The checker replaced is kept on si, as OMPL's bindings keep there the function they were
+        # given: OMPL's wrapper of a Python function destroyed while the script runs leaves the
+        # script's SimpleSetup alive when it exits, which nanobind then reports as leaked.
+        si._ompl_balance_replaced_checker = checker
         si.setStateValidityChecker(CountingValidityChecker(si, checker if function is None else function))
 
 
