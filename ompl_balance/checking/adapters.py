@@ -223,8 +223,9 @@ class FunctionMotionValidator(ob.MotionValidator):
 
 
 def _counters(function: CheckFunction) -> dict[str, int]:
-    counts = function.counts
-    return {"states_checked": int(counts[Count.STATES]), "motions_checked": int(counts[Count.MOTIONS])}
+    # (one read of the counts: counters are read twice a solve)
+    states, motions = function.counts[Count.STATES : Count.MOTIONS + 1].tolist()
+    return {"states_checked": states, "motions_checked": motions}
 
 
 def space_information(target: Any) -> ob.SpaceInformation:

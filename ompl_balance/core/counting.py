@@ -84,10 +84,9 @@ class CountingValidityChecker(ob.StateValidityChecker):
     def counters(self) -> dict[str, int]:
         """States decided since construction or the last reset (by ``isValid`` and by compiled
         code) and the motions compiled code decided (OMPL's validator counts the others)."""
-        return {
-            "states_checked": self.states_checked + int(self.counts[Count.STATES]),
-            "motions_checked": int(self.counts[Count.MOTIONS]),
-        }
+        # (one read of the counts: counters are read twice a solve)
+        states, motions = self.counts[Count.STATES : Count.MOTIONS + 1].tolist()
+        return {"states_checked": self.states_checked + states, "motions_checked": motions}
 
     def reset_counters(self) -> None:
         self.states_checked = 0
@@ -203,11 +202,12 @@ def read_work(si: ob.SpaceInformation) -> WorkCount:
     come from the motion validator's ``counters()`` when it has them, else from
     OMPL's own motion counter.
     """
-    checker = si.getStateValidityChecker()
-    counters = checker.counters() if hasattr(checker, "counters") else {}
+    checker_counters = getattr(si.getStateValidityChecker(), "counters", None)
+    counters = {} if checker_counters is None else checker_counters()
     validator = si.getMotionValidator()
-    if validator is not None and hasattr(validator, "counters"):
-        counters = {**counters, **validator.counters()}
+    validator_counters = getattr(validator, "counters", None)
+    if validator_counters is not None:
+        counters = {**counters, **validator_counters()}
         motions = counters["motions_checked"]
     else:  # OMPL's own validator, and the motions compiled code decided by its rule
         motions = counters.get("motions_checked", 0) + (0 if validator is None else validator.getCheckedMotionCount())

@@ -69,7 +69,7 @@ class ArrayPoints:
         self._scratch = (si.allocState(), si.allocState())
         self._leaves = leaf_spaces(self._space)
         self._space_measures = resolution_measures(self._space, self._leaves)
-        self._largest = max(float(np.abs(layout.low).max(initial=0.0)), float(np.abs(layout.high).max(initial=0.0)))
+        self._largest = max(map(abs, layout.low.tolist() + layout.high.tolist()), default=0.0)  # (numpy: slower here)
 
     def restarted(self, rng: np.random.Generator) -> Points:
         """These points, drawing from ``rng`` from now on (a fresh block of samples), for the next

@@ -11,6 +11,7 @@ plans on the compiled engine never loads it.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import importlib
 import math
@@ -21,6 +22,7 @@ import tempfile
 from collections.abc import Callable
 from functools import partial
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 from ompl import base as ob
@@ -83,6 +85,13 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
         warm_exits = getattr(module, "warm_exits", None)
         if warm_exits is not None:
             warm_exits()
+
+
+@functools.cache
+def _driver() -> ModuleType:
+    """:mod:`ompl_balance.engine.driver` (it imports numba), imported at the first compiled solve
+    and kept: an import statement in a solve costs a microsecond each time."""
+    return importlib.import_module(".driver", __package__)
 
 
 def runs_compiled(checks: EngineChecks, engine: str) -> bool:
@@ -151,10 +160,8 @@ class CompiledEngine:
         which a solve's time does not count."""
         if self._key is None or not LOADER.ready(self._key):
             return
-        from .driver import SolveArrays
-
         if self._arrays is None or self._arrays.layout is not points.layout:
-            self._arrays = SolveArrays(points.layout)
+            self._arrays = _driver().SolveArrays(points.layout)
         start_tree, goal_tree = trees
         assert isinstance(start_tree, ArrayTree) and isinstance(goal_tree, ArrayTree)
         self._arrays.hold(start_tree, goal_tree, failures, room)
@@ -190,11 +197,10 @@ class CompiledEngine:
         room: int,
         ptc: ob.PlannerTerminationCondition,
     ) -> tuple[Any, str]:
-        from .driver import SolveArrays, run
-
+        driver = _driver()
         if self._arrays is None or self._arrays.layout is not layout:
-            self._arrays = SolveArrays(layout)
-        return run(solve, ptc, checks, key, room, self._arrays), checks.path
+            self._arrays = driver.SolveArrays(layout)
+        return driver.run(solve, ptc, checks, key, room, self._arrays), checks.path
 
 
 def _describe(checks: EngineChecks) -> str:

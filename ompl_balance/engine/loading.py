@@ -41,7 +41,7 @@ def view_key(value: Any) -> Any:
     kind = type(value)
     if issubclass(kind, np.ndarray):
         flags = value.flags
-        return (value.dtype.str, value.ndim, flags.c_contiguous, flags.writeable)
+        return (value.dtype, value.ndim, flags.c_contiguous, flags.writeable)
     if not issubclass(kind, tuple):
         return kind
     if not hasattr(kind, "_fields"):
