@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from ompl import base as ob
 
-from ..core.checks import Count, load_kernels
+from ..core.checks import Count, load_kernels, states_and_motions
 from ..core.compiled_calls import entry_point
 from ..core.discrete_motion_kernels import bisection_order
 from ..core.discrete_motions import DiscreteMotions, discrete_motions
@@ -223,8 +223,7 @@ class FunctionMotionValidator(ob.MotionValidator):
 
 
 def _counters(function: CheckFunction) -> dict[str, int]:
-    # (one read of the counts: counters are read twice a solve)
-    states, motions = function.counts[Count.STATES : Count.MOTIONS + 1].tolist()
+    states, motions = states_and_motions(function.counts)
     return {"states_checked": states, "motions_checked": motions}
 
 

@@ -34,7 +34,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from .checks import Count, new_counts
+from .checks import new_counts, states_and_motions
 from .exit_release import release_at_exit
 
 
@@ -84,8 +84,7 @@ class CountingValidityChecker(ob.StateValidityChecker):
     def counters(self) -> dict[str, int]:
         """States decided since construction or the last reset (by ``isValid`` and by compiled
         code) and the motions compiled code decided (OMPL's validator counts the others)."""
-        # (one read of the counts: counters are read twice a solve)
-        states, motions = self.counts[Count.STATES : Count.MOTIONS + 1].tolist()
+        states, motions = states_and_motions(self.counts)
         return {"states_checked": self.states_checked + states, "motions_checked": motions}
 
     def reset_counters(self) -> None:

@@ -63,9 +63,9 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
     from ..core.compiled_calls import load_cached, signature_of  # (these import numba)
     from ..core.kernel_cache import package_digest
     from . import loop
-    from .driver import warm_up, warm_up_arguments
 
-    arguments = warm_up_arguments(view, layout)
+    driver = _driver()
+    arguments = driver.warm_up_arguments(view, layout)
     if not load_cached(loop.run, arguments):
         try:
             # one compilation of this specialization at a time on the machine (the next finds it
@@ -80,7 +80,7 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
                     )
         except (OSError, subprocess.SubprocessError, pickle.PicklingError):
             pass  # compiled here instead
-    warm_up(view, layout)
+    driver.warm_up(view, layout)
     for module in modules:  # the exits to Python, run once (see their warm_exits)
         warm_exits = getattr(module, "warm_exits", None)
         if warm_exits is not None:
