@@ -137,6 +137,32 @@ def test_a_borrowing_kernel_reads_its_callers_arrays_and_refuses_to_allocate():
         _allocates(3)
 
 
+def _doubling_kernel_and_caller(jit: Any) -> tuple[Any, Any]:
+    """A kernel made with ``jit``, and a caller that passes it a variable and two constants."""
+
+    def twice(x: int) -> int:  # pragma: no cover (compiled)
+        return 2 * x
+
+    kernel = jit(twice)
+
+    def call(x: int) -> int:  # pragma: no cover (compiled)
+        return kernel(x) + kernel(3) + kernel(-1)
+
+    return kernel, numba.njit(call)
+
+
+@pytest.mark.parametrize("jit", [kernel_cache.njit, kernel_cache.njit_borrowing])
+def test_a_kernel_called_with_constants_compiles_once_for_their_plain_type(jit: Any) -> None:
+    # numba alone compiles the callee once for the variable and once for each constant ...
+    plain_kernel, plain_caller = _doubling_kernel_and_caller(numba.njit)
+    assert plain_caller(5) == 14
+    assert len(plain_kernel.signatures) == 3
+    # ... the package's kernels once: a constant is typed as the variable is
+    kernel, caller = _doubling_kernel_and_caller(jit)
+    assert caller(5) == 14
+    assert [str(signature) for signature in kernel.signatures] == ["(int64,)"]
+
+
 def _allocating_kernel_and_borrowing_caller(jit: Any) -> tuple[Any, Any]:
     """A kernel made with ``jit`` that allocates, and a borrowing caller of it: neither compiled
     yet, nor cached (each run compiles the kernel from its caller, as a fresh install does)."""

@@ -4,15 +4,18 @@
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 from numba import types
-from numba.extending import overload
+from numba.core.imputils import lower_builtin
+from numba.extending import type_callable
 
 from .checks import motion_free, state_free, steps_free
+from .kernel_cache import njit_borrowing
 
-#: view class -> its own compiled ``steps(view, chain, steps, outward)``, where it has one
-_STEPS_KERNELS: dict[type, Any] = {}
+#: ``(state_free, motion_free or steps_free; a view class)`` -> the view's compiled kernel for it
+_KERNELS: dict[tuple[Any, type], Any] = {}
 
 
 def register_kernels(view_class: type, state: Any = None, motion: Any = None, steps: Any = None) -> None:
@@ -21,61 +24,68 @@ def register_kernels(view_class: type, state: Any = None, motion: Any = None, st
     of ``view_class`` (a named tuple class). Without ``steps`` the view's steps are checked one by
     one with its ``state_free`` and ``motion_free``.
 
-    Not inlined in numba's IR (``inline="always"``): the loop calls them in many places, and numba
-    types every inlined copy again (the box world's engine compiled in 46 s inlined, 28 s not);
-    LLVM still inlines the calls where it pays (the 2-D solves' times are the same either way).
+    A call of ``state_free(view, q)`` in compiled code is compiled as a call of ``state(view, q)``
+    itself. Not through a function of numba's ``overload`` that calls it: numba compiles such a
+    function on its own, and optimizes and emits the machine code of everything it calls again
+    (a robot's certified kernels: 3.5 s of the first compilation). Nor inlined in numba's IR:
+    the loop calls them in many places, and numba types every inlined copy again (the box
+    world's engine compiled in 46 s inlined, 28 s not). LLVM still inlines the calls where it pays.
     """
-
-    def is_view(view: Any) -> bool:
-        return isinstance(view, types.BaseNamedTuple) and getattr(view, "instance_class", None) is view_class
-
-    if state is not None:
-
-        def state_typing(view: Any, q: Any) -> Any:
-            if not is_view(view):
-                return None
-
-            def implementation(view: Any, q: Any) -> Any:
-                return state(view, q)
-
-            return implementation
-
-        overload(state_free)(state_typing)
-    if motion is not None:
-
-        def motion_typing(view: Any, a: Any, b: Any) -> Any:
-            if not is_view(view):
-                return None
-
-            def implementation(view: Any, a: Any, b: Any) -> Any:
-                return motion(view, a, b)
-
-            return implementation
-
-        overload(motion_free)(motion_typing)
-    if steps is not None:
-        _STEPS_KERNELS[view_class] = steps
+    for function, kernel in ((state_free, state), (motion_free, motion), (steps_free, steps)):
+        if kernel is not None:
+            _KERNELS[function, view_class] = kernel
 
 
-@overload(steps_free)
-def _steps_typing(view: Any, chain: Any, steps: Any, outward: Any) -> Any:
-    """``steps_free`` of any view: its own kernel (:func:`register_kernels`), else one step at a time."""
-    own = _STEPS_KERNELS.get(getattr(view, "instance_class", type(None)))
-    if own is not None:
+def _kernel(function: Any, view: Any) -> Any:
+    """The compiled kernel a call of ``function`` with a view of numba type ``view`` calls, or ``None``."""
+    view_class = getattr(view, "instance_class", None) if isinstance(view, types.BaseNamedTuple) else None
+    kernel = _KERNELS.get((function, view_class))
+    if kernel is None and function is steps_free and (state_free, view_class) in _KERNELS:
+        return _one_by_one
+    return kernel
 
-        def implementation(view: Any, chain: Any, steps: Any, outward: Any) -> Any:
-            return own(view, chain, steps, outward)
 
-        return implementation
+@njit_borrowing
+def _one_by_one(view: Any, chain: Any, steps: int, outward: bool) -> int:  # pragma: no cover (compiled)
+    """``steps_free`` of a view without a kernel of its own: one step at a time."""
+    for k in range(1, steps + 1):
+        if outward:
+            free = motion_free(view, chain[k - 1], chain[k])
+        else:
+            free = state_free(view, chain[k]) and motion_free(view, chain[k], chain[k - 1])
+        if not free:
+            return k - 1
+    return steps
 
-    def one_by_one(view: Any, chain: Any, steps: Any, outward: Any) -> Any:
-        for k in range(1, steps + 1):
-            if outward:
-                free = motion_free(view, chain[k - 1], chain[k])
-            else:
-                free = state_free(view, chain[k]) and motion_free(view, chain[k], chain[k - 1])
-            if not free:
-                return k - 1
-        return steps
 
-    return one_by_one
+def _typed(function: Any, context: Any, arguments: tuple[Any, ...]) -> Any:
+    """The signature of ``function(*arguments)``: its view's kernel's (compiled now if need be)."""
+    kernel = _kernel(function, arguments[0])
+    if kernel is None:
+        return None
+    return context.resolve_function_type(types.Dispatcher(kernel), arguments, {})
+
+
+@type_callable(state_free)
+def _state_typing(context: Any) -> Any:
+    return lambda view, q: _typed(state_free, context, (view, q))
+
+
+@type_callable(motion_free)
+def _motion_typing(context: Any) -> Any:
+    return lambda view, a, b: _typed(motion_free, context, (view, a, b))
+
+
+@type_callable(steps_free)
+def _steps_typing(context: Any) -> Any:
+    return lambda view, chain, steps, outward: _typed(steps_free, context, (view, chain, steps, outward))
+
+
+def _call_kernel(function: Any, context: Any, builder: Any, signature: Any, arguments: Any) -> Any:
+    """A call of ``function`` (``state_free``, ...) lowered as a call of its view's kernel."""
+    kernel = _kernel(function, signature.args[0])
+    return context.get_function(types.Dispatcher(kernel), signature)(builder, arguments)
+
+
+for _function, _arity in ((state_free, 2), (motion_free, 3), (steps_free, 4)):
+    lower_builtin(_function, *(types.Any,) * _arity)(functools.partial(_call_kernel, _function))

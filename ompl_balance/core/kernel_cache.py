@@ -27,17 +27,27 @@ from pathlib import Path
 from typing import Any, TypeVar, cast
 
 import numba
-from numba.core import caching
+from numba.core import caching, types
+from numba.core.registry import CPUDispatcher
 
 from .file_lock import file_lock
 
-__all__ = ["LockedCacheFile", "PackageCacheLocator", "cache_folder", "njit", "njit_borrowing", "package_digest"]
+__all__ = [
+    "LockedCacheFile",
+    "PackageCacheLocator",
+    "PlainTypedDispatcher",
+    "cache_folder",
+    "njit",
+    "njit_borrowing",
+    "package_digest",
+]
 
 _Kernel = TypeVar("_Kernel", bound=Callable[..., Any])
 
 
 def njit(*args: Any, **options: Any) -> Any:
-    """numba's ``njit``, with numba's reference counting stated rather than left to inherit.
+    """numba's ``njit``, with numba's reference counting stated rather than left to inherit, and
+    calls from compiled code typed plainly (:class:`PlainTypedDispatcher`).
 
     numba compiles a kernel the first time compiled code calls it with the caller's setting of
     reference counting unless the kernel states its own; a kernel that allocates, first called
@@ -45,7 +55,10 @@ def njit(*args: Any, **options: Any) -> Any:
     compile, or compile, depending on which was compiled first in the process.
     """
     options.setdefault("_nrt", True)  # (numba's option for it, undeclared in its stubs)
-    return numba.njit(*args, **options)
+    made = numba.njit(*args, **options)
+    if isinstance(made, CPUDispatcher):
+        return _plainly_typed(made)
+    return lambda function: _plainly_typed(made(function))
 
 
 def njit_borrowing(function: _Kernel) -> _Kernel:
@@ -58,8 +71,29 @@ def njit_borrowing(function: _Kernel) -> _Kernel:
     space's layout and a tree (25 arrays) through three calls cost 1.6 us on a tree of 8 nodes,
     against 26 ns for the scan itself.
     """
-    options: dict[str, Any] = {"cache": True, "_nrt": False}  # (numba's option, undeclared in its stubs)
-    return cast(_Kernel, numba.njit(**options)(function))
+    return cast(_Kernel, njit(cache=True, _nrt=False)(function))
+
+
+class PlainTypedDispatcher(CPUDispatcher):
+    """numba's dispatcher of a kernel, compiling a call from compiled code for its arguments' plain
+    types.
+
+    numba types a constant argument as a literal (``_note(loop, 0, -1)`` passes
+    ``Literal[int](0)``) and compiles the callee once more for each such constant: the package's
+    kernels were compiled up to four times over for constants alone (the rigid bodies' edge
+    kernel twice, 6 s), all of it paid at first use. Typed plainly, one compilation serves every
+    caller; LLVM still sees the constant where the call is inlined.
+    """
+
+    def get_call_template(self, args: Any, kws: Any) -> Any:
+        plain_args = tuple(types.unliteral(arg) for arg in args)
+        plain_kws = {name: types.unliteral(arg) for name, arg in kws.items()}
+        return super().get_call_template(plain_args, plain_kws)
+
+
+def _plainly_typed(dispatcher: Any) -> Any:
+    dispatcher.__class__ = PlainTypedDispatcher  # (the same dispatcher, one method more specific)
+    return dispatcher
 
 
 #: The package's folder: functions defined in files below it are cached by :class:`PackageCacheLocator`.
