@@ -101,7 +101,9 @@ def make_ready(parent: int) -> None:
     """Make the compiled engine ready for each of :data:`KINDS` (compiled into numba's cache,
     or loaded from it), while process ``parent`` (the tests') runs."""
     from ompl_balance import BalancedRRTConnect
+    from ompl_balance.engine.compiled import compile_in_this_process
 
+    compile_in_this_process()  # (this process only compiles: no worker process needed)
     for make in KINDS:
         if os.getppid() != parent:  # (the tests ended without stopping this process: killed)
             return

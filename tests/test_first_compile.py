@@ -3,6 +3,7 @@ the first test run: the engine's kinds of check compiled ahead of the tests that
 
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import compile_ahead
 import numpy as np
 import pytest
 
+import ompl_balance
 from ompl_balance.bench import first_compile
 from ompl_balance.core import kernel_cache
 from ompl_balance.core.discrete_motion_kernels import bisection_order
@@ -35,7 +37,8 @@ def slow_modules(tmp_path, monkeypatch):
     for name, seconds in (("slow_one", 1.0), ("slow_two", 1.0), ("short", 0.3), ("long", 4.0)):
         (modules / f"{name}.py").write_text(SLOW_MODULE.replace("SECONDS", str(seconds)))
     (tmp_path / "imports").mkdir()
-    monkeypatch.setenv("PYTHONPATH", str(modules))
+    package_parent = str(Path(ompl_balance.__file__).resolve().parents[1])  # (the package the tests import)
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join((str(modules), package_parent)))
     monkeypatch.setenv("IMPORTS", str(tmp_path / "imports"))
     monkeypatch.setattr(kernel_cache, "cache_folder", lambda: tmp_path)  # where the done markers go
     monkeypatch.setattr(first_compile.os, "cpu_count", lambda: 2)
@@ -114,3 +117,24 @@ def _group_alive(group: int) -> bool:
         if int(fields[2]) == group and fields[0] != "Z":
             return True
     return False
+
+
+def test_a_process_that_only_compiles_compiles_the_engine_itself(monkeypatch):
+    # a process that plans has a missing engine compiled by a worker process (its interpreter
+    # stays free); one that only compiles does it in itself, without a worker's start-up
+    from ompl_balance.core import compiled_calls
+    from ompl_balance.engine import compiled
+
+    si = compile_ahead.KINDS[3]().getSpaceInformation()  # the box world
+    si.setup()
+    layout = layout_for(si.getStateSpace())
+    view = checks_for(si, layout).view
+    workers = []
+    monkeypatch.setattr(compiled_calls, "load_cached", lambda kernel, arguments: False)  # (as if not cached)
+    monkeypatch.setattr(compiled.subprocess, "run", lambda command, **options: workers.append(command))
+    compiled._warm(view, layout)
+    assert len(workers) == 1 and workers[0][-1] == "ompl_balance.engine.compile_worker"
+    monkeypatch.setattr(compiled._Compiling, "in_this_process", False)
+    compiled.compile_in_this_process()
+    compiled._warm(view, layout)  # (loaded from numba's cache here: the warm-up finds it there)
+    assert len(workers) == 1

@@ -20,6 +20,8 @@ from pathlib import Path
 
 #: Seconds between looks at the compiling processes.
 _POLL = 0.1
+#: What a compiling process runs before it imports its module.
+_COMPILE_HERE = "from ompl_balance.engine.compiled import compile_in_this_process; compile_in_this_process()"
 
 
 def _done_marker(module: str) -> Path:
@@ -54,7 +56,8 @@ def compile_in_parallel(modules: list[str]) -> None:
         while pending and len(running) < (os.cpu_count() or 1):
             module = pending.pop(0)
             # (standard output: OMPL's Info lines, which must not reach the tables on the caller's)
-            command = [sys.executable, "-c", f"import {module}"]
+            # (the engine compiled in the process itself: it does nothing else)
+            command = [sys.executable, "-c", f"{_COMPILE_HERE}; import {module}"]
             running.append((module, subprocess.Popen(command, env=environment, stdout=subprocess.DEVNULL)))
         ended = [(module, process) for module, process in running if process.poll() is not None]
         for module, process in ended:

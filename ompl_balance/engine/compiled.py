@@ -54,11 +54,27 @@ def room_per_iteration(layout: SpaceLayout, extent: float, step: float, intermed
     return steps * per_step + 1
 
 
+class _Compiling:
+    """Where this process has a missing specialization of the engine compiled (see :func:`_warm`)."""
+
+    in_this_process = False
+
+
+def compile_in_this_process() -> None:
+    """Have this process compile the engine's missing specializations itself rather than in a
+    worker process: for processes that only compile (the first sweep's,
+    :func:`ompl_balance.bench.first_compile.compile_in_parallel`), where holding the interpreter
+    costs nothing and a worker's start-up and the loading of its work after it would cost some
+    seconds per specialization."""
+    _Compiling.in_this_process = True
+
+
 def _warm(view: Any, layout: SpaceLayout) -> None:
     """Make the engine for ``view`` and ``layout`` ready in this process: loaded from numba's cache,
     or, when it is not there, compiled into it by another process first
     (:mod:`ompl_balance.engine.compile_worker`; a compilation takes tens of seconds, mostly in
-    Python, and would hold this interpreter), then loaded."""
+    Python, and would hold this interpreter), then loaded; compiled here in a process that only
+    compiles (:func:`compile_in_this_process`)."""
     modules = [importlib.import_module(module) for module in kernel_modules(view)]
     from ..core.compiled_calls import load_cached, signature_of  # (these import numba)
     from ..core.kernel_cache import package_digest
@@ -71,7 +87,9 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
             # one compilation of this specialization at a time on the machine (the next finds it
             # cached); other specializations compile alongside, on the other cores
             with _compile_lock(f"{package_digest()} {signature_of(arguments)}"):
-                if not load_cached(loop.run, arguments):
+                if _Compiling.in_this_process:
+                    driver.warm_up(view, layout)  # (compiled now, unless another process just did)
+                elif not load_cached(loop.run, arguments):
                     subprocess.run(
                         [sys.executable, "-m", "ompl_balance.engine.compile_worker"],
                         input=pickle.dumps((view, layout)),
