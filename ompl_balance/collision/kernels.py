@@ -379,15 +379,9 @@ def certified_motion_free(view: CertifiedMotions, a: np.ndarray, b: np.ndarray) 
     return certified_edge_free(view.edge, view.memory, view.lines, view.scratch, view.counts, view.handle, a, b)
 
 
-@njit(cache=True)
-def _states_of_free(view: Any, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
-    """A motion view's state check: its checker's."""
-    return robot_state_free(view.states, q)
-
-
 register_kernels(RobotStates, state=robot_state_free)
-register_kernels(RobotDiscreteMotions, state=_states_of_free, motion=robot_discrete_motion_free)
-register_kernels(CertifiedMotions, state=_states_of_free, motion=certified_motion_free)
+register_kernels(RobotDiscreteMotions, state="states", motion=robot_discrete_motion_free)
+register_kernels(CertifiedMotions, state="states", motion=certified_motion_free)
 
 
 def warm_stand_ins() -> tuple[Chain, Volumes, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -9,6 +9,7 @@ from typing import Any
 
 from numba import types
 from numba.core.imputils import lower_builtin
+from numba.core.typing import signature
 from numba.extending import type_callable
 
 from .checks import motion_free, state_free, steps_free
@@ -21,15 +22,17 @@ _KERNELS: dict[tuple[Any, type], Any] = {}
 def register_kernels(view_class: type, state: Any = None, motion: Any = None, steps: Any = None) -> None:
     """Make compiled ``state(view, q)``, ``motion(view, a, b)`` and ``steps(view, chain, steps,
     outward)`` (numba functions) the ``state_free``, ``motion_free`` and ``steps_free`` of views
-    of ``view_class`` (a named tuple class). Without ``steps`` the view's steps are checked one by
-    one with its ``state_free`` and ``motion_free``.
+    of ``view_class`` (a named tuple class). ``state`` may instead name a field of the view that
+    holds the view whose ``state_free`` checks its states (a motion view's ``"states"``). Without
+    ``steps`` the view's steps are checked one by one with its ``state_free`` and ``motion_free``.
 
     A call of ``state_free(view, q)`` in compiled code is compiled as a call of ``state(view, q)``
-    itself. Not through a function of numba's ``overload`` that calls it: numba compiles such a
-    function on its own, and optimizes and emits the machine code of everything it calls again
-    (a robot's certified kernels: 3.5 s of the first compilation). Nor inlined in numba's IR:
-    the loop calls them in many places, and numba types every inlined copy again (the box
-    world's engine compiled in 46 s inlined, 28 s not). LLVM still inlines the calls where it pays.
+    itself (of the named field's kernel with the field). Not through a function of numba's
+    ``overload`` that calls it: numba compiles such a function on its own, and optimizes and
+    emits the machine code of everything it calls again (a robot's certified kernels: 3.5 s of the
+    first compilation). Nor inlined in numba's IR: the loop calls them in many places, and numba
+    types every inlined copy again (the box world's engine compiled in 46 s inlined, 28 s not).
+    LLVM still inlines the calls where it pays.
     """
     for function, kernel in ((state_free, state), (motion_free, motion), (steps_free, steps)):
         if kernel is not None:
@@ -37,7 +40,8 @@ def register_kernels(view_class: type, state: Any = None, motion: Any = None, st
 
 
 def _kernel(function: Any, view: Any) -> Any:
-    """The compiled kernel a call of ``function`` with a view of numba type ``view`` calls, or ``None``."""
+    """What a call of ``function`` with a view of numba type ``view`` calls: its compiled kernel, the
+    name of the view's field to call it with, or ``None``."""
     view_class = getattr(view, "instance_class", None) if isinstance(view, types.BaseNamedTuple) else None
     kernel = _KERNELS.get((function, view_class))
     if kernel is None and function is steps_free and (state_free, view_class) in _KERNELS:
@@ -60,7 +64,10 @@ def _one_by_one(view: Any, chain: Any, steps: int, outward: bool) -> int:  # pra
 
 def _typed(function: Any, context: Any, arguments: tuple[Any, ...]) -> Any:
     """The signature of ``function(*arguments)``: its view's kernel's (compiled now if need be)."""
-    kernel = _kernel(function, arguments[0])
+    view, kernel = arguments[0], _kernel(function, arguments[0])
+    if isinstance(kernel, str):  # (the kernel of the view in that field)
+        field = _typed(function, context, (view[view.fields.index(kernel)], *arguments[1:]))
+        return None if field is None else signature(field.return_type, view, *field.args[1:])
     if kernel is None:
         return None
     return context.resolve_function_type(types.Dispatcher(kernel), arguments, {})
@@ -81,10 +88,16 @@ def _steps_typing(context: Any) -> Any:
     return lambda view, chain, steps, outward: _typed(steps_free, context, (view, chain, steps, outward))
 
 
-def _call_kernel(function: Any, context: Any, builder: Any, signature: Any, arguments: Any) -> Any:
+def _call_kernel(function: Any, context: Any, builder: Any, called: Any, arguments: Any) -> Any:
     """A call of ``function`` (``state_free``, ...) lowered as a call of its view's kernel."""
-    kernel = _kernel(function, signature.args[0])
-    return context.get_function(types.Dispatcher(kernel), signature)(builder, arguments)
+    view, kernel = called.args[0], _kernel(function, called.args[0])
+    if isinstance(kernel, str):
+        index = view.fields.index(kernel)
+        field = signature(called.return_type, view[index], *called.args[1:])
+        return _call_kernel(
+            function, context, builder, field, (builder.extract_value(arguments[0], index), *arguments[1:])
+        )
+    return context.get_function(types.Dispatcher(kernel), called)(builder, arguments)
 
 
 for _function, _arity in ((state_free, 2), (motion_free, 3), (steps_free, 4)):

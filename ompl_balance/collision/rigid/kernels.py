@@ -147,13 +147,8 @@ def rigid_certified_motion_free(
     return decide_motion(states.handle, a, b)
 
 
-@njit(cache=True)
-def _motion_view_state_free(view: RigidCertifiedMotions, state: np.ndarray) -> bool:  # pragma: no cover
-    return rigid_state_free(view.states, state)
-
-
 register_kernels(RigidStates, state=rigid_state_free)
-register_kernels(RigidCertifiedMotions, state=_motion_view_state_free, motion=rigid_certified_motion_free)
+register_kernels(RigidCertifiedMotions, state="states", motion=rigid_certified_motion_free)
 
 
 class _AllFree:
