@@ -412,11 +412,17 @@ def states_status(
     ``view.counts[3]`` counts the GJK bounds computed."""
     status = np.empty(len(states), dtype=np.int64)
     bounds = 0
+    pose = view.pose[0]
     for i in range(len(states)):
         status[i] = state_status(view, states[i])
         bounds += view.counts[BOUNDS_COMPUTED]
-        poses[i] = view.pose[0]
-        undecided[i, :] = False
+        # (element by element: an array assigned to a slice has numba compile its shape-mismatch
+        # error, string formatting and all, some 3 s of the first compilation)
+        for row in range(4):
+            for column in range(4):
+                poses[i, row, column] = pose[row, column]
+        for pair in range(undecided.shape[1]):
+            undecided[i, pair] = False
         for k in range(view.counts[UNDECIDED_PAIRS]):
             undecided[i, view.undecided[k]] = True
     view.counts[BOUNDS_COMPUTED] = bounds
