@@ -16,7 +16,7 @@ from .checks import motion_free, state_free, steps_free
 from .kernel_cache import njit_borrowing
 
 #: ``(state_free, motion_free or steps_free; a view class)`` -> the view's compiled kernel for it
-_KERNELS: dict[tuple[Any, type], Any] = {}
+_KERNELS: dict[tuple[Any, type | None], Any] = {}
 
 
 def register_kernels(view_class: type, state: Any = None, motion: Any = None, steps: Any = None) -> None:
@@ -45,12 +45,12 @@ def _kernel(function: Any, view: Any) -> Any:
     view_class = getattr(view, "instance_class", None) if isinstance(view, types.BaseNamedTuple) else None
     kernel = _KERNELS.get((function, view_class))
     if kernel is None and function is steps_free and (state_free, view_class) in _KERNELS:
-        return _one_by_one
+        return steps_one_by_one
     return kernel
 
 
 @njit_borrowing
-def _one_by_one(view: Any, chain: Any, steps: int, outward: bool) -> int:  # pragma: no cover (compiled)
+def steps_one_by_one(view: Any, chain: Any, steps: int, outward: bool) -> int:  # pragma: no cover (compiled)
     """``steps_free`` of a view without a kernel of its own: one step at a time."""
     for k in range(1, steps + 1):
         if outward:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .check_overloads import register_kernels
+from .check_overloads import register_kernels, steps_one_by_one
 from .checks import Count
 from .compiled_spaces import interpolate, segment_count
 from .discrete_motion_kernels import fraction_between, order_between
@@ -108,14 +108,7 @@ def exit_steps_free(view: ExitChecks, chain: np.ndarray, steps: int, outward: bo
     exit (in as many as the rows need), in the order and with the counts of checking them one by
     one; otherwise a state and a motion at a time."""
     if not view.batched:
-        for k in range(1, steps + 1):
-            if outward:
-                free = exit_motion_free(view, chain[k - 1], chain[k])
-            else:
-                free = exit_state_free(view, chain[k]) and exit_motion_free(view, chain[k], chain[k - 1])
-            if not free:
-                return k - 1
-        return steps
+        return steps_one_by_one(view, chain, steps, outward)
     filled = 0
     for k in range(1, steps + 1):
         if outward:
