@@ -48,6 +48,7 @@ from .bench.compare import (
     parse_planners,
 )
 from .bench.errors import ClusterError, ExperimentError, MissingExtraError
+from .bench.execution import TIMED_AGAIN
 from .bench.experiment import Experiment, PlannerSpec
 from .bench.experiment_file import load_experiment
 from .bench.problems import problem_by_name
@@ -332,8 +333,13 @@ def _run(experiment: Experiment, out: Path, args: argparse.Namespace, temporary:
     records = bench(experiment, out, jobs=args.jobs, dask=args.dask, progress=not args.no_progress)
     print((out / "summary.md").read_text(), end="")
     crashed = sum(bool(r["error"]) for r in records)
+    timed_again = sum(TIMED_AGAIN in r.get("note", "") for r in records)
     where = "in a temporary folder, now deleted (-o OUT keeps results, logs and database)" if temporary else f"in {out}"
-    print(f"\n{len(records)} runs {where}" + (f"; {crashed} crashed or killed (see results.jsonl)" if crashed else ""))
+    print(
+        f"\n{len(records)} runs {where}"
+        + (f"; {crashed} crashed or killed (see results.jsonl)" if crashed else "")
+        + (f"; {timed_again} timed again, numba having compiled during their first solve" if timed_again else "")
+    )
     return 0
 
 

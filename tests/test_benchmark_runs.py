@@ -5,12 +5,14 @@ from __future__ import annotations
 import ctypes
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+import numba
 import pytest
 from fresh_process import with_ctrl_c_as_in_a_terminal
 from ompl import base as ob
@@ -161,6 +163,50 @@ def test_a_run_that_solved_then_overran_in_simplification_is_recorded_as_solved(
     assert "simplified solution length REAL" not in properties
     assert "path simplification" in record["note"] and "did not return" in record["note"]
     assert "crashed" not in (tmp_path / "summary.md").read_text()
+
+
+@numba.njit
+def _free_beside_a_wall(x: float, y: float) -> bool:  # (not cached: compiled at its first call in a process)
+    return not (0.45 < x < 0.55 and y < 0.8)
+
+
+def lazily_compiled_world() -> og.SimpleSetup:
+    """A square with a wall whose validity checker calls a numba function compiled at its first call."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda state: bool(_free_beside_a_wall(state[0], state[1])))
+    start, goal = space.allocState(), space.allocState()
+    start[0], start[1], goal[0], goal[1] = 0.1, 0.1, 0.9, 0.1
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
+@pytest.mark.parametrize("warm_up", [False, True])
+def test_a_solve_during_which_numba_compiled_is_timed_again(tmp_path, warm_up):
+    """Without a warm-up the run's first solve compiles the checker's numba function: the run is
+    timed again in its process, and its record is the second solve's (no compiling in its time),
+    with a note; the warm-up compiles it, and the run is timed once."""
+    experiment = Experiment(
+        name="lazy",
+        problems=(ProblemSpec("lazy", "factory", "test_benchmark_runs:lazily_compiled_world"),),
+        planners=(PlannerSpec("RRTConnect", "RRTConnect"),),
+        runs=1,
+        time_limit=5.0,
+        seed=3,
+        warm_up=warm_up,
+    )
+    start_forkserver(preload_modules(experiment))
+    (record,) = bench(experiment, tmp_path, jobs=1, progress=False)
+    properties = record["properties"]
+    assert record["status"] == "EXACT_SOLUTION" and properties["solved BOOLEAN"] == 1
+    timed_again = re.search(r"timed again: numba compiled for (\d+) ms during its first solve", record.get("note", ""))
+    if warm_up:
+        assert timed_again is None, record.get("note")
+    else:
+        assert timed_again is not None, record.get("note")
+        assert "during this one" not in record["note"]  # the second solve compiled nothing
+        assert properties["time REAL"] * 1e3 < int(timed_again.group(1))  # a 2-D solve, without the compiling
 
 
 RESUME_TOML = """\

@@ -493,7 +493,10 @@ def warm_exits_once() -> None:
 def warm_exits() -> None:
     """Run each exit to Python once: numba makes a kernel's ``objmode`` code ready the first
     time it runs in a process (about a tenth of a second), which would otherwise fall on the
-    first FCL query of a solve."""
+    first FCL query of a solve. That readies it for the kernels compiled in the same process as
+    these (numba finds the block's code again by the identity it gave it when compiling); a
+    kernel compiled by another process, and cached, gets its block ready at its first exit (the
+    benchmark runner times such a solve again: :class:`~ompl_balance.bench.execution.NumbaCompiling`)."""
     target = _AllFree()
     handle = exit_handle(target)
     q = np.zeros(1)

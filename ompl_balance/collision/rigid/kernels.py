@@ -160,7 +160,8 @@ class _AllFree:
 
 def warm_exits() -> None:
     """Run the exits to Python once: numba makes a kernel's ``objmode`` code ready the first time
-    it runs in a process (about a tenth of a second), which would otherwise fall in a solve."""
+    it runs in a process (about a tenth of a second), which would otherwise fall in a solve (for
+    the kernels compiled in the same process as these: see the robot kernels' ``warm_exits``)."""
     target = _AllFree()  # held here: the registry holds it weakly
     handle, q = exit_handle(target), np.zeros(3)
     decide_state(handle, q)
