@@ -48,7 +48,7 @@ from .bench.compare import (
     parse_planners,
 )
 from .bench.errors import ClusterError, ExperimentError, MissingExtraError
-from .bench.execution import TIMED_AGAIN
+from .bench.execution import TIME_INCLUDES_COMPILING, TIMED_AGAIN
 from .bench.experiment import Experiment, PlannerSpec
 from .bench.experiment_file import load_experiment
 from .bench.problems import problem_by_name
@@ -334,11 +334,13 @@ def _run(experiment: Experiment, out: Path, args: argparse.Namespace, temporary:
     print((out / "summary.md").read_text(), end="")
     crashed = sum(bool(r["error"]) for r in records)
     timed_again = sum(TIMED_AGAIN in r.get("note", "") for r in records)
+    compiling = sum(TIME_INCLUDES_COMPILING in r.get("note", "") for r in records)
     where = "in a temporary folder, now deleted (-o OUT keeps results, logs and database)" if temporary else f"in {out}"
     print(
         f"\n{len(records)} runs {where}"
         + (f"; {crashed} crashed or killed (see results.jsonl)" if crashed else "")
         + (f"; {timed_again} timed again, numba having compiled during their first solve" if timed_again else "")
+        + (f"; {compiling} with numba compiling in their time (see their notes)" if compiling else "")
     )
     return 0
 

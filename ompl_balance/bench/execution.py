@@ -35,8 +35,8 @@ from .results import STATUS_INDEX, Record, failure_properties, run_record, statu
 #: solve to its first solution (see :class:`~ompl_balance.bench.progress_sampler.FirstSolutionWatch`).
 FIRST_SOLUTION_TIME = "first solution time REAL"
 
-#: What the note of a run timed again says first (see :func:`execute`).
-TIMED_AGAIN = "timed again"
+#: What the note of a run timed again says (see :func:`execute`), and of one whose time includes compiling.
+TIMED_AGAIN, TIME_INCLUDES_COMPILING = "timed again", "which its time includes"
 
 #: The phases of a run, in order, as :func:`execute` reports them. ``"engine"``: a planner of the
 #: package makes its compiled engine ready (loaded, or compiled on a first use after installing),
@@ -209,29 +209,26 @@ def execute(task: RunTask, phase: Callable[[str, Record | None], None] = _no_pha
     The planner's progress properties, sampled every 0.05 s during the solve, go to the
     record's ``progress``. A solve that raises is recorded with OMPL's ``CRASH`` status.
 
-    A run whose timed solve made numba compile code (:class:`NumbaCompiling`) is run again in the
-    same process, from its seed as the first time (problem, planner and warm-up made anew), and
-    its record is the second's, with a note saying so: the compiled code is then ready, as the
-    warm-up means it to be. (Peak memory is the process's, so such a run's ``memory REAL`` counts
-    from the peak the first try left.)
+    A short timed solve during which numba compiled code (:class:`NumbaCompiling`) is run again
+    in the same process, from its seed as the first time (problem, planner and warm-up made
+    anew), and the run's record is the second's, with a note saying so: the compiled code is
+    then ready, as the warm-up means it to be. Short: within half the hard limit's margin over
+    planning and simplifying, so that both fit in it; a longer solve that compiled keeps its
+    record, with a note that its time includes the compiling. (Peak memory is the process's, so
+    a run timed again counts its ``memory REAL`` from the peak the first try left.)
     """
-    record, compiled = _execute(task, phase, first_try=True)
-    if compiled <= 0.0:
-        return record
-    record, again = _execute(task, phase, first_try=False)
-    notes = [
-        record.get("note", ""),
-        f"{TIMED_AGAIN}: numba compiled for {compiled * 1e3:.0f} ms during its first solve",
-    ]
-    if again > 0.0:
-        notes.append(f"and for {again * 1e3:.0f} ms during this one, which its time includes")
-    record["note"] = "; ".join(note for note in notes if note)
+    record, compiled = _execute(task, phase, retime=True)
+    if compiled > 0.0:
+        record, _ = _execute(task, phase, retime=False, compiled_before=compiled)
     return record
 
 
-def _execute(task: RunTask, phase: Callable[[str, Record | None], None], first_try: bool) -> tuple[Record, float]:
-    """:func:`execute`'s run: the record and the seconds numba compiled during the timed solve (on
-    the ``first_try``, a solve that compiled returns at once, without simplifying its path)."""
+def _execute(
+    task: RunTask, phase: Callable[[str, Record | None], None], retime: bool, compiled_before: float = 0.0
+) -> tuple[Record, float]:
+    """:func:`execute`'s run, and the seconds numba compiled during its timed solve when it is to
+    be timed again (``retime``, a short solve: returned at once, its path not simplified), else
+    0; ``compiled_before``: the seconds the first try's solve compiled, for the note."""
     seed_ompl(task.seed)  # before this run makes anything that draws random numbers
     ss = task.problem.build()
     si = ss.getSpaceInformation()
@@ -308,10 +305,16 @@ def _execute(task: RunTask, phase: Callable[[str, Record | None], None], first_t
     properties.update(stats_properties(planner, _MEASURED_HERE))
     properties["memory REAL"] = _peak_memory() - memory.start  # MB the run added (OMPL: after minus before)
     record = run_record(task, status_text, properties, params, "", improving)
-    if memory.reached:
-        record["note"] = f"stopped at the memory limit of {task.memory_limit:g} MB"
-    if first_try and compiling.seconds > 0.0:
-        return record, compiling.seconds  # (timed again: see execute)
+    notes = [f"stopped at the memory limit of {task.memory_limit:g} MB"] if memory.reached else []
+    compiled = compiling.seconds
+    if retime and compiled > 0.0 and elapsed <= (task.hard_limit - 2 * task.time_limit) / 2:
+        return record, compiled  # (timed again: see execute)
+    if compiled_before > 0.0:
+        notes.append(f"{TIMED_AGAIN}: numba compiled for {compiled_before * 1e3:.0f} ms during its first solve")
+    if compiled > 0.0:
+        notes.append(f"numba compiled for {compiled * 1e3:.0f} ms during this solve, {TIME_INCLUDES_COMPILING}")
+    if notes:
+        record["note"] = "; ".join(notes)
     if solved:
         phase("simplification", _finish(record, planner, sampler))
         began = time.perf_counter()
@@ -324,7 +327,7 @@ def _execute(task: RunTask, phase: Callable[[str, Record | None], None], first_t
                 typed("simplified solution segments", simplified.getStateCount() - 1),
             ]
         )
-    return _finish(record, planner, sampler), compiling.seconds
+    return _finish(record, planner, sampler), 0.0
 
 
 def _finish(record: Record, planner: ob.Planner, sampler: ProgressSampler) -> Record:
