@@ -406,6 +406,9 @@ def test_every_preset_runs_in_ompl_benchmark(tmp_path):
 def test_gaussian_passage_preset_uses_the_passage_sampler():
     ss = get_problem("narrow_gap").setup()
     planner = GaussianPassageRRTConnect(ss.getSpaceInformation())
+    # every target the sampler's: with the default uniform_rate, a solve of one iteration whose
+    # target was uniform (one in ten) asks the sampler nothing
+    assert planner.params().setParam("uniform_rate", "0")
     ss.setPlanner(planner)
     assert ss.solve(10.0)
     assert type(planner._valid_sampler).__name__ == "PassageSampler"
