@@ -41,6 +41,7 @@ from .collision.kinematics import RobotModel
 from .collision.rigid.checker import RigidBodyChecker, certify_rigid_states
 from .collision.rigid.kernels import RigidCertifiedMotions, RigidStates
 from .collision.rigid.motion import interpolate, interpolate_many
+from .core.checks import raise_kept
 from .core.compiled_calls import entry_point
 from .core.layout import layout_for
 
@@ -78,6 +79,10 @@ class StateValidityChecker(ob.StateValidityChecker):
         """The checker's view for compiled code (:class:`~ompl_balance.collision.kernels.RobotStates`)."""
         return self.checker.kernel_view()
 
+    def raise_error(self) -> None:
+        """Raise the error the checker met in compiled code (FCL's, for the engine to report)."""
+        self.checker.raise_error()
+
     def counters(self) -> dict[str, int]:
         return self.checker.counters()
 
@@ -100,6 +105,10 @@ class _RobotMotionValidator(ob.MotionValidator):
 
     def reset_counters(self) -> None:
         self.checker.reset_counters()
+
+    def raise_error(self) -> None:
+        """Raise the error a check met in compiled code (FCL's, for the engine to report)."""
+        self.checker.raise_error()
 
     @staticmethod
     def _set_last_valid(last_valid: ob.State | None, a: np.ndarray, b: np.ndarray, fraction: float) -> None:
@@ -172,7 +181,9 @@ class MotionValidator(_RobotMotionValidator):
             return False, 0.0
         if last_valid is None:
             view = self.compiled_view()
-            return bool(self._motion_free(view, a, b)), 1.0
+            free = bool(self._motion_free(view, a, b))
+            raise_kept(view.counts, self.checker)
+            return free, 1.0
         self.checker.counter.motions_checked += 1
         nd = self._space.validSegmentCount(s1, s2)
         t = np.arange(1, nd + 1) / nd
@@ -227,6 +238,11 @@ class CertifiedMotionValidator(_RobotMotionValidator):
     def compiled_view(self) -> CertifiedMotions:
         """The validator as compiled code sees it (:class:`~ompl_balance.collision.kernels.CertifiedMotions`)."""
         return self.certifier.compiled_view()
+
+    def raise_error(self) -> None:
+        """Raise the error a check met in compiled code (FCL's, for the engine to report)."""
+        self.checker.raise_error()
+        self.certifier.raise_error()
 
     @property
     def clearance(self) -> float:
@@ -390,6 +406,10 @@ class RigidBodyValidityChecker(ob.StateValidityChecker):
         """The checker's view for compiled code (:class:`~ompl_balance.collision.rigid.kernels.RigidStates`)."""
         return self.checker.kernel_view()
 
+    def raise_error(self) -> None:
+        """Raise the error the checker met in compiled code (FCL's, for the engine to report)."""
+        self.checker.raise_error()
+
     def counters(self) -> dict[str, int]:
         return self.checker.counters()
 
@@ -412,6 +432,10 @@ class _RigidBodyMotionValidator(ob.MotionValidator):
 
     def reset_counters(self) -> None:
         self.checker.reset_counters()
+
+    def raise_error(self) -> None:
+        """Raise the error the checker met in compiled code (FCL's, for the engine to report)."""
+        self.checker.raise_error()
 
     def _values(self, state: ob.State) -> np.ndarray:
         return rigid_state_values(state, self._size)

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from ompl import base as ob
 from ompl import geometric as og
-from test_validity import arm3_scene
+from test_validity import FCLError, arm3_scene, failing_fcl
 
 import ompl_balance
 from ompl_balance import BalancedRRTConnect
@@ -348,6 +348,56 @@ def test_touching_non_convex_parts_are_tested_with_fcl_first(monkeypatch):
             assert checker.counters()["states_checked"] - states < 60
             refused_at_probe += 1
     assert refused_at_probe >= 3
+
+
+def test_hard_segments_staged_in_parts_get_the_same_answers(monkeypatch):
+    """Edges whose hard segments outnumber what the certifier's exit stages at once send them to
+    FCL in parts: a certifier staging one segment at a time answers every edge as one with the
+    usual room, with the same work counted, and such edges are met. Edges as RRT-Connect extends
+    them in the Panda's box problem (its non-convex link touches the obstacles' hulls)."""
+    robot = panda()
+    problem = load_mbm("box", robot.joint_names)[0]
+    usual = certified.MotionCertifier(CollisionChecker(robot, problem.environment))
+    exits = certified.segment_exits
+    monkeypatch.setattr(certified, "segment_exits", lambda certifier, dof, rows: exits(certifier, dof, 1))
+    one_at_a_time = certified.MotionCertifier(CollisionChecker(robot, problem.environment))
+    kinds = []
+    answer = certified.MotionCertifier.answer
+    monkeypatch.setattr(
+        certified.MotionCertifier, "answer", lambda self, kind, count: kinds.append(kind) or answer(self, kind, count)
+    )
+    rng = np.random.default_rng(11)
+    for a in [problem.start, *problem.goals] * 40:
+        toward = rng.uniform(robot.lower, robot.upper) - a
+        b = a + toward * min(1.0, 2.5 / np.linalg.norm(toward))
+        assert one_at_a_time.check(a, b) == usual.check(a, b)
+    assert one_at_a_time.checker.counters() == usual.checker.counters()
+    assert kinds.count(certified.Exit.STAGE_SEGMENTS) >= 3
+
+
+def test_an_error_in_fcl_on_hard_segments_reaches_the_caller(monkeypatch):
+    """FCL raising on the hard segments the kernel sends to the certifier: ``check`` raises that
+    error; once FCL answers again, the certifier answers every edge as a fresh one does."""
+    robot = panda()
+    problem = load_mbm("box", robot.joint_names)[0]
+    certifier = certified.MotionCertifier(CollisionChecker(robot, problem.environment))
+    rng = np.random.default_rng(12)
+    edges = []
+    for a in [problem.start, *problem.goals] * 10:
+        toward = rng.uniform(robot.lower, robot.upper) - a
+        edges.append((a, a + toward * min(1.0, 2.5 / np.linalg.norm(toward))))
+    raised = 0
+    with monkeypatch.context() as patched:
+        for name in ("pair_touching", "pair_distance"):
+            patched.setattr(certifier.checker, name, failing_fcl)
+        for a, b in edges:
+            try:
+                certifier.check(a, b)
+            except FCLError:
+                raised += 1
+    assert raised >= 3
+    fresh = certified.MotionCertifier(CollisionChecker(robot, problem.environment))
+    assert [certifier.check(a, b) for a, b in edges] == [fresh.check(a, b) for a, b in edges]
 
 
 def test_probe_order_visits_every_segment_coarse_to_fine():

@@ -17,7 +17,9 @@ from numba import njit
 from ompl import base as ob
 from rigid_oracles import DenseCheck, box_triangles, inside_box, place, triangles_separation
 from scipy.spatial.transform import Rotation
+from test_validity import FCLError, failing_fcl
 
+from ompl_balance import BalancedRRTConnect
 from ompl_balance.collision.environment import Environment
 from ompl_balance.collision.geometry import Shape
 from ompl_balance.collision.rigid.advance import edge_status
@@ -26,7 +28,8 @@ from ompl_balance.collision.rigid.checker import RigidBodyChecker
 from ompl_balance.collision.rigid.kernels import RigidCertifiedMotions, rigid_certified_motion_free
 from ompl_balance.collision.rigid.motion import interpolate, motion_split, state_pose
 from ompl_balance.collision.rigid.view import COLLIDING, FREE, UNDECIDED, state_status
-from ompl_balance.validity import rigid_body_space, rigid_state_values, set_rigid_state
+from ompl_balance.validity import certify_path, rigid_body_space, rigid_state_values, set_rigid_state
+from ompl_balance.worlds.rigid import rigid_problem
 
 STEP = 1e-3  # the dense check's resolution: largest move of any point between two checked poses
 
@@ -520,3 +523,22 @@ def test_discrete_validator_matches_ompls_own(name):
             np.testing.assert_allclose(rigid_state_values(last, len(a)), rigid_state_values(probe, len(a)), atol=1e-9)
         outcomes.append(valid)
     assert 5 <= sum(outcomes) <= len(outcomes) - 5
+
+
+def test_an_error_in_fcl_reaches_the_caller_and_the_planner_plans_on(monkeypatch):
+    """FCL raising in what the compiled engine's kernels left undecided (reached through the
+    checker's exit) ends the solve with that error; once FCL answers again, the same planner
+    solves, and its path is certified."""
+    problem = rigid_problem("se3_room")
+    checker = problem.checker()
+    ss = problem.simple_setup(checker=checker)
+    planner = BalancedRRTConnect(ss.getSpaceInformation())
+    planner.setEngine("compiled")
+    planner.params().setParam("seed", "1")  # (its solve reaches FCL: 163 exits)
+    ss.setPlanner(planner)
+    with monkeypatch.context() as patched:
+        patched.setattr(checker, "decide", failing_fcl)
+        with pytest.raises(FCLError, match="the test's FCL failure"):
+            ss.solve(30.0)
+    assert ss.solve(30.0)
+    assert certify_path(checker, ss.getSolutionPath()).certified

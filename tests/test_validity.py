@@ -308,3 +308,58 @@ def test_warm_up_compiles_the_kernels_real_checkers_use():
     checker.is_valid(q[0])
     robot.body_poses(q)
     assert len(screen.signatures) == 1 and len(_chain_poses_batch.signatures) == 1
+
+
+class FCLError(RuntimeError):
+    """The error the tests have FCL raise."""
+
+
+def failing_fcl(*arguments):
+    raise FCLError("the test's FCL failure")
+
+
+def state_fcl_decides(checker, rng):
+    """A free configuration whose screening leaves a pair to FCL (the checker's exit taken)."""
+    while True:
+        q = rng.uniform(checker.robot.lower, checker.robot.upper)
+        exits = checker.counter.exits
+        if checker.is_valid(q) and checker.counter.exits > exits:
+            return q
+
+
+@pytest.mark.parametrize(
+    ("motion", "engine"),
+    [("discrete", "compiled"), ("discrete", "python"), ("discrete", "stock"), ("certified", "compiled")],
+)
+def test_an_error_in_fcl_reaches_the_caller_and_the_planner_plans_on(motion, engine, monkeypatch):
+    """FCL raising in a state check that compiled code sent to it (through the checker's exit)
+    ends the solve with that error, on both engines and under a stock planner; once FCL answers
+    again, the same planner solves, and its path's states are free. The package's planners solve
+    from a seed whose solve is known to reach FCL; the stock planner (which no seed parameter
+    repeats) starts where FCL decides. (The certified motions of this scene never reach FCL: its
+    obstacles are convex. Their exit's errors are tested in test_certified.py.)"""
+    robot, environment, _ = arm3_scene()
+    checker = CollisionChecker(robot, environment)
+    ss = og.SimpleSetup(space_for(robot))
+    setup_robot(ss, checker, motion=motion)
+    si = ss.getSpaceInformation()
+    start, goal = si.allocState(), si.allocState()
+    begin = state_fcl_decides(checker, np.random.default_rng(5)) if engine == "stock" else [0.0, -1.0, 0.1]
+    for i, (a, b) in enumerate(zip(begin, [2.5, 1.0, 0.1])):
+        start[i], goal[i] = a, b
+    ss.setStartAndGoalStates(start, goal)
+    planner = og.RRTConnect(si) if engine == "stock" else BalancedRRTConnect(si)
+    if engine != "stock":
+        planner.setEngine(engine)
+        planner.params().setParam("seed", "2")  # (its solve reaches FCL: 12 exits, 2 certified)
+    ss.setPlanner(planner)
+    with monkeypatch.context() as patched:
+        for name in ("decide", "pair_touching", "pair_distance"):
+            patched.setattr(checker, name, failing_fcl)
+        with pytest.raises(FCLError, match="the test's FCL failure"):
+            ss.solve(10.0)
+    if engine == "stock":
+        return
+    assert ss.solve(10.0)
+    path = ss.getSolutionPath()
+    assert checker.check(np.array([path.getState(i)[0:3] for i in range(path.getStateCount())])).all()

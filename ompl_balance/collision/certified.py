@@ -82,7 +82,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.checks import exit_handle
+from ..core.checks import ExitTarget, raise_kept
 from ..core.compiled_calls import entry_point
 from .advancement import (
     DISTANCE_TOLERANCE,
@@ -101,7 +101,20 @@ from .budget import MOTION_BUDGET, UNLIMITED, OverBudgetError, WorkBudget, budge
 from .certified_lines import LINES_REMEMBERED, along_certified, certified_lines, remember_certified
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
-from .kernels import CertifiedMotions, certified_edge_free, robot_states
+from .kernels import (
+    END_ROW,
+    EXIT_NO,
+    EXIT_OVER_BUDGET,
+    EXIT_YES,
+    SEGMENTS,
+    START_ROW,
+    WORK_LEFT,
+    WORK_SPENT,
+    CertifiedMotions,
+    Exit,
+    certified_edge_free,
+    segment_exits,
+)
 from .travel import travel_weights
 
 #: Travel (m) to which ``check(..., last_valid=True)`` refines the edge around its first
@@ -109,7 +122,7 @@ from .travel import travel_weights
 LAST_VALID_TRAVEL = 1e-3
 
 
-class MotionCertifier:
+class MotionCertifier(ExitTarget):
     """Proves straight joint-space edges free of collision for a checker's model, or rejects them.
 
     Parameters
@@ -177,14 +190,16 @@ class MotionCertifier:
         lower = np.ascontiguousarray(robot.lower, dtype=float)
         self._lines = certified_lines(LINES_REMEMBERED, robot.dof)
         self._view = CertifiedMotions(
-            robot_states(checker),
+            checker.kernel_view(),
             self._edge,
             self._memory,
             self._lines,
             self._scratch,
-            exit_handle(self),
+            segment_exits(self, robot.dof, capacity),
             checker.counter.array,
         )
+        # the parts of a query about more segments than the exit stages at once (see answer)
+        self._staged: list[tuple[np.ndarray, np.ndarray]] = []
         self._row = entry_point(memory_row, (self._memory, lower))
         self._advance = entry_point(
             advance,
@@ -192,7 +207,16 @@ class MotionCertifier:
         )
         self._edge_free = entry_point(
             certified_edge_free,
-            (self._edge, self._memory, self._lines, self._scratch, checker.counter.array, 0, lower, lower),
+            (
+                self._edge,
+                self._memory,
+                self._lines,
+                self._scratch,
+                checker.counter.array,
+                self._view.exits,
+                lower,
+                lower,
+            ),
         )
         self._remember = entry_point(remember_certified, (self._lines, lower, lower))
         self._along = entry_point(along_certified, (self._lines, lower, lower))
@@ -261,8 +285,9 @@ class MotionCertifier:
         if self.checker.prefilter and not last_valid:
             view = self._view
             free = bool(
-                self._edge_free(view.edge, view.memory, view.lines, view.scratch, view.counts, view.handle, a, b)
+                self._edge_free(view.edge, view.memory, view.lines, view.scratch, view.counts, view.exits, a, b)
             )
+            raise_kept(view.counts, self)
             return free, 1.0 if free else 0.0
         counter.motions_checked += 1
         free, fraction, over_budget = self._prove(a, b, last_valid)
@@ -314,6 +339,37 @@ class MotionCertifier:
     def compiled_view(self) -> CertifiedMotions:
         """The certifier as compiled code sees it (:class:`~ompl_balance.collision.kernels.CertifiedMotions`)."""
         return self._view
+
+    def answer(self, kind: int, count: int) -> int:
+        """The exit's answer (:class:`~ompl_balance.collision.kernels.Exit`) about the segments the
+        kernel staged in :attr:`~ompl_balance.collision.kernels.CertifiedMotions.exits` (the first
+        ``count`` rows; those of earlier ``STAGE_SEGMENTS`` queries before them):
+        :meth:`hard_segments_free` or :meth:`hard_segments_touch` as ``EXIT_YES``, ``EXIT_NO`` or
+        ``EXIT_OVER_BUDGET``, the work units spent written back."""
+        exits = self._view.exits
+        pairs, spans = exits.pairs[:count].copy(), exits.spans[:count].copy()
+        if kind == Exit.STAGE_SEGMENTS:
+            self._staged.append((pairs, spans))
+            return 0
+        if self._staged:  # (the query's own parts are the last ``total`` rows)
+            total = int(exits.numbers[SEGMENTS])
+            pairs = np.concatenate([part for part, _ in self._staged] + [pairs])[-total:]
+            spans = np.concatenate([part for _, part in self._staged] + [spans])[-total:]
+            self._staged.clear()
+        a, b = exits.ends[0].copy(), exits.ends[1].copy()
+        budget = WorkBudget(int(exits.numbers[WORK_LEFT]))
+        try:
+            if kind == Exit.SEGMENTS_FREE:
+                start, end = int(exits.numbers[START_ROW]), int(exits.numbers[END_ROW])
+                free = self.hard_segments_free(a, b, pairs, spans, start, end, budget)
+                return EXIT_YES if free else EXIT_OVER_BUDGET if budget.exhausted else EXIT_NO
+            if kind == Exit.SEGMENTS_TOUCH:
+                return EXIT_YES if self.hard_segments_touch(a, b, pairs, spans, budget) else EXIT_NO
+        except OverBudgetError:
+            return EXIT_OVER_BUDGET
+        finally:
+            exits.numbers[WORK_SPENT] = budget.spent
+        raise ValueError(f"a motion certifier answers the segment queries of Exit, not query {kind}")
 
     def hard_segments_free(
         self,

@@ -29,12 +29,12 @@ import fcl
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core.checks import Count, new_counts
+from ..core.checks import Count, ExitTarget, new_counts, raise_kept
 from ..core.compiled_calls import entry_point
 from .contacts import OBSTACLE, SELF, Contact, geometry_names
 from .environment import Environment
 from .geometry import fcl_transform
-from .kernels import RobotStates, robot_state_free, robot_states, warm_exits_once
+from .kernels import Exit, RobotStates, robot_state_free, robot_states
 from .kinematics import RobotModel
 from .screening import Volumes, build_volumes, screen
 
@@ -85,7 +85,7 @@ class WorkCounter:
         self.array[:] = 0
 
 
-class CollisionChecker:
+class CollisionChecker(ExitTarget):
     """Exact collision checks of a robot among static obstacles, batched over configurations.
 
     Parameters
@@ -134,7 +134,6 @@ class CollisionChecker:
         self._kernel = entry_point(screen, arguments)  # compiled or loaded now, not in a solve
         self._view = robot_states(self)
         self._state_free = entry_point(robot_state_free, (self._view, np.zeros(robot.dof)))
-        warm_exits_once()  # the first FCL query of a process would pay it inside a solve
 
     # ------------------------------------------------------------------ public API
 
@@ -166,7 +165,9 @@ class CollisionChecker:
         if len(q) != 1:
             raise ValueError(f"is_valid takes one configuration of {self.robot.dof} joint values, got shape {q.shape}")
         if self.prefilter:  # the compiled engine's own state check (limits, screening, FCL)
-            return bool(self._state_free(self._view, np.ascontiguousarray(q[0])))
+            free = bool(self._state_free(self._view, np.ascontiguousarray(q[0])))
+            raise_kept(self.counter.array, self)
+            return free
         self.counter.states_checked += 1
         return bool(self.robot.within_limits(q)[0]) and self._free_reference(self.robot.body_poses(q)[0])
 
@@ -297,6 +298,14 @@ class CollisionChecker:
         """The checker as compiled code sees it (:class:`~ompl_balance.collision.kernels.RobotStates`):
         its arrays, and the exit to :meth:`decide` for the pairs the screening leaves to FCL."""
         return self._view
+
+    def answer(self, kind: int, count: int) -> int:
+        """The exit's answer (:class:`~ompl_balance.collision.kernels.Exit`): :meth:`decide` on the
+        configuration the kernel screened into the view's one-row arrays, 1 free, 0 not."""
+        if kind != Exit.DECIDE:
+            raise ValueError(f"a collision checker answers Exit.DECIDE, not query {kind}")
+        view = self._view
+        return int(self.decide(view.poses[0], view.obstacle_hits[0], view.self_hits[0]))
 
     # ------------------------------------------------------------------ internals
 

@@ -5,7 +5,8 @@ Three views (:mod:`ompl_balance.core.checks`), each a named tuple of arrays:
 * :class:`RobotStates`: a :class:`~ompl_balance.collision.checker.CollisionChecker` deciding a
   configuration: the joint limits, then forward kinematics and the bounding-volume screening
   (:func:`~ompl_balance.collision.screening.screen`), and when a pair is not cleared, one exit
-  to the checker's FCL test (:meth:`~ompl_balance.collision.checker.CollisionChecker.decide`);
+  to the checker's FCL test (:meth:`~ompl_balance.collision.checker.CollisionChecker.decide`) on
+  the screening's arrays for one configuration, which the checker owns;
 * :class:`RobotDiscreteMotions`: the discrete motion validator
   (:class:`~ompl_balance.validity.MotionValidator`): the end state alone, then the states at
   ``j / n`` of the way (``n`` as OMPL's ``validSegmentCount``) in one batch of screening,
@@ -13,7 +14,12 @@ Three views (:mod:`ompl_balance.core.checks`), each a named tuple of arrays:
 * :class:`CertifiedMotions`: certified motions (:class:`~ompl_balance.collision.certified.MotionCertifier`):
   conservative advancement in compiled code (:func:`~ompl_balance.collision.advancement.advance`),
   and one exit to FCL for the hard segments of non-convex pairs, within the certifier's work
-  budget per motion (:mod:`ompl_balance.collision.budget`).
+  budget per motion (:mod:`ompl_balance.collision.budget`), the segments staged in the
+  certifier's :class:`SegmentExits`.
+
+The exits are C callbacks (:mod:`ompl_balance.core.checks`): they carry integers, the query is in
+the staging arrays, and an error in one (FCL's, a Ctrl-C) sets ``counts[Count.RAISED]`` for the
+caller to raise (:func:`~ompl_balance.core.checks.raise_kept`).
 
 The Python validators call these same kernels (through fixed-type entry points), so a stock
 planner and the compiled engine get the same answers and the same counts. Work is counted
@@ -22,18 +28,18 @@ in the checker's :class:`~ompl_balance.collision.checker.WorkCounter` array.
 
 from __future__ import annotations
 
+import enum
 from typing import Any, NamedTuple
 
 import numpy as np
-from numba import objmode
 
 from ..core.check_overloads import register_kernels
-from ..core.checks import Count, exit_handle, exit_target
+from ..core.checks import EXIT_ADDRESS, Count, exit_handle
 from ..core.compiled_spaces import segment_count
+from ..core.function_pointers import call_exit
 from ..core.kernel_cache import njit
 from ..core.layout import SpaceLayout
 from .advancement import EdgeModel, EdgeScratch, EndMemory, advance, memory_row
-from .budget import OverBudgetError, WorkBudget
 from .certified_lines import CertifiedLines, along_certified, certified_lines, remember_certified
 from .kinematics import LIMIT_TOLERANCE, Chain
 from .screening import Volumes, screen
@@ -45,8 +51,8 @@ class RobotStates(NamedTuple):
     ``chain`` and ``volumes``: the robot and the screening's bounding volumes; ``lower``,
     ``upper`` (dof,): the joint limits; ``q`` (1, dof), ``poses`` (1, bodies, 4, 4),
     ``obstacle_hits`` (1, obstacles, geometries) and ``self_hits`` (1, pairs): the screening's
-    scratch for one configuration; ``handle``: the exit to the checker; ``counts``: its work
-    counter's array.
+    scratch for one configuration, the checker's own (its exit reads them); ``address`` and
+    ``handle``: the exit to the checker (:class:`Exit`); ``counts``: its work counter's array.
     """
 
     chain: Chain
@@ -57,8 +63,22 @@ class RobotStates(NamedTuple):
     poses: np.ndarray
     obstacle_hits: np.ndarray
     self_hits: np.ndarray
+    address: int
     handle: int
     counts: np.ndarray
+
+
+class Exit(enum.IntEnum):
+    """What the robot kernels' exits ask (the ``kind`` of :func:`~ompl_balance.core.function_pointers.call_exit`)."""
+
+    DECIDE = 0  # the checker: FCL on the configuration in its view's one-row arrays: 1 free, 0 not
+    STAGE_SEGMENTS = 1  # the certifier: keep the segments staged, more follow
+    SEGMENTS_FREE = 2  # the certifier: FCL certifies the segments: EXIT_YES, EXIT_NO or EXIT_OVER_BUDGET
+    SEGMENTS_TOUCH = 3  # the certifier: FCL finds a contact in them: EXIT_YES, EXIT_NO or EXIT_OVER_BUDGET
+
+
+# (as plain integers for compiled code)
+_DECIDE, _STAGE_SEGMENTS, _SEGMENTS_FREE, _SEGMENTS_TOUCH = (int(kind) for kind in Exit)
 
 
 def screening_arrays(checker: Any, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -74,7 +94,8 @@ def screening_arrays(checker: Any, rows: int) -> tuple[np.ndarray, np.ndarray, n
 
 
 def robot_states(checker: Any) -> RobotStates:
-    """The :class:`RobotStates` view of a :class:`~ompl_balance.collision.checker.CollisionChecker`."""
+    """The :class:`RobotStates` view of a :class:`~ompl_balance.collision.checker.CollisionChecker`
+    (the checker makes it once: its exit answers about this view's arrays)."""
     robot = checker.robot
     q, poses, obstacle_hits, self_hits = screening_arrays(checker, 1)
     return RobotStates(
@@ -86,13 +107,10 @@ def robot_states(checker: Any) -> RobotStates:
         poses,
         obstacle_hits,
         self_hits,
+        EXIT_ADDRESS,
         exit_handle(checker),
         checker.counter.array,
     )
-
-
-def _decide(handle: int, poses: np.ndarray, obstacle_hits: np.ndarray, self_hits: np.ndarray) -> bool:
-    return bool(exit_target(handle).decide(poses, obstacle_hits, self_hits))
 
 
 @njit(cache=True)
@@ -105,14 +123,15 @@ def within_limits(view: RobotStates, q: np.ndarray) -> bool:  # pragma: no cover
 
 
 @njit(cache=True)
-def decide_screened(
-    view: RobotStates, poses: np.ndarray, obstacle_hits: np.ndarray, self_hits: np.ndarray
-) -> bool:  # pragma: no cover (compiled)
-    """FCL on what the screening of one configuration left (one exit to the checker)."""
+def decide_screened(view: RobotStates) -> bool:  # pragma: no cover (compiled)
+    """FCL on what the screening of one configuration left, in the view's one-row arrays (one
+    exit to the checker); ``False`` with ``counts[Count.RAISED]`` set when the checker raised."""
     view.counts[Count.EXITS] += 1
-    with objmode(free="boolean"):
-        free = _decide(view.handle, poses, obstacle_hits, self_hits)
-    return free
+    answer = call_exit(view.address, view.handle, _DECIDE, 0)
+    if answer < 0:
+        view.counts[Count.RAISED] = 1
+        return False
+    return answer == 1
 
 
 @njit(cache=True)
@@ -124,7 +143,7 @@ def robot_state_free(view: RobotStates, q: np.ndarray) -> bool:  # pragma: no co
     for j in range(q.shape[0]):
         view.q[0, j] = q[j]
     maybe = screen(view.q, view.chain, view.volumes, view.poses, view.obstacle_hits, view.self_hits)
-    return not maybe[0] or decide_screened(view, view.poses[0], view.obstacle_hits[0], view.self_hits[0])
+    return not maybe[0] or decide_screened(view)
 
 
 class RobotDiscreteMotions(NamedTuple):
@@ -153,7 +172,7 @@ def robot_discrete_motions(checker: Any, layout: SpaceLayout, rows: int) -> Robo
     order = np.zeros(rows + 1, dtype=np.int64)
     intervals = np.zeros((2 * rows + 2, 2), dtype=np.int64)
     return RobotDiscreteMotions(
-        robot_states(checker), layout, q, poses, obstacle_hits, self_hits, order, intervals, checker.counter.array
+        checker.kernel_view(), layout, q, poses, obstacle_hits, self_hits, order, intervals, checker.counter.array
     )
 
 
@@ -220,24 +239,67 @@ def robot_discrete_motion_free(view: RobotDiscreteMotions, a: np.ndarray, b: np.
             q[k, j] = a[j] + t * (b[j] - a[j])
     view.counts[Count.STATES] += rows
     maybe = screen(q[:rows], view.states.chain, view.states.volumes, poses, obstacle_hits, self_hits)
+    states = view.states
     for k in range(rows):
-        if maybe[k] and not decide_screened(view.states, poses[k], obstacle_hits[k], self_hits[k]):
-            return False
+        if maybe[k]:
+            states.poses[0] = poses[k]  # (what the checker's exit reads)
+            states.obstacle_hits[0] = obstacle_hits[k]
+            states.self_hits[0] = self_hits[k]
+            if not decide_screened(states):
+                return False
     return True
+
+
+class SegmentExits(NamedTuple):
+    """A certifier's exit to FCL for the hard segments of an edge, and what it stages there.
+
+    ``address`` and ``handle``: the exit to the certifier (:class:`Exit`); ``ends`` (2, dof): the
+    edge's ends; ``pairs`` (rows,) and ``spans`` (rows, 4): hard segments, ``(pair, (t0, t1, d0,
+    d1))`` (more than ``rows`` go in parts: :func:`segments_exit`); ``numbers`` (:data:`NUMBERS`,)
+    int64: the end-memory rows of the ends, the work units left, the segments in all, and the work
+    units the exit spent (its answer).
+    """
+
+    address: int
+    handle: int
+    ends: np.ndarray
+    pairs: np.ndarray
+    spans: np.ndarray
+    numbers: np.ndarray
+
+
+#: The entries of :attr:`SegmentExits.numbers`.
+START_ROW, END_ROW, WORK_LEFT, SEGMENTS, WORK_SPENT = range(5)
+NUMBERS = 5
+
+
+def segment_exits(certifier: Any, dof: int, rows: int) -> SegmentExits:
+    """The :class:`SegmentExits` of ``certifier`` (the exit's target) for a robot of ``dof`` joints,
+    staging up to ``rows`` (>= 1) segments at a time."""
+    if rows < 1:
+        raise ValueError(f"a segment exit stages at least 1 segment at a time, got {rows}")
+    return SegmentExits(
+        EXIT_ADDRESS,
+        exit_handle(certifier),
+        np.zeros((2, dof)),
+        np.zeros(rows, dtype=np.int64),
+        np.zeros((rows, 4)),
+        np.zeros(NUMBERS, dtype=np.int64),
+    )
 
 
 class CertifiedMotions(NamedTuple):
     """Certified motions as compiled code sees them: the checker's ``states`` view, the
     certifier's ``edge`` model, end ``memory`` and ``scratch`` (:mod:`~ompl_balance.collision.advancement`),
     the edges it certified lately (:mod:`~ompl_balance.collision.certified_lines`),
-    the exit ``handle`` to the certifier (FCL on the hard segments) and the work ``counts``."""
+    its ``exits`` to FCL on the hard segments and the work ``counts``."""
 
     states: RobotStates
     edge: EdgeModel
     memory: EndMemory
     lines: CertifiedLines
     scratch: EdgeScratch
-    handle: int
+    exits: SegmentExits
     counts: np.ndarray
 
 
@@ -247,25 +309,6 @@ class CertifiedMotions(NamedTuple):
 EXIT_NO, EXIT_YES, EXIT_OVER_BUDGET = 0, 1, 2
 
 
-def _exact(
-    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int, left: int
-) -> int:
-    budget = WorkBudget(left)
-    free = exit_target(handle).hard_segments_free(a, b, pairs, spans, start, end, budget)
-    return EXIT_YES if free else EXIT_OVER_BUDGET if budget.exhausted else EXIT_NO
-
-
-def _touching(
-    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, left: int
-) -> tuple[int, int]:
-    budget = WorkBudget(left)
-    try:
-        touching = exit_target(handle).hard_segments_touch(a, b, pairs, spans, budget)
-    except OverBudgetError:
-        return EXIT_OVER_BUDGET, budget.spent
-    return EXIT_YES if touching else EXIT_NO, budget.spent
-
-
 @njit(cache=True)
 def certified_edge_free(
     edge: EdgeModel,
@@ -273,7 +316,7 @@ def certified_edge_free(
     lines: CertifiedLines,
     scratch: EdgeScratch,
     counts: np.ndarray,
-    handle: int,
+    exits: SegmentExits,
     a: np.ndarray,
     b: np.ndarray,
 ) -> bool:  # pragma: no cover (compiled)
@@ -285,7 +328,7 @@ def certified_edge_free(
     needs, so that Python callers pass no more.)
     """
     counts[Count.MOTIONS] += 1
-    proof = prove_edge(edge, memory, scratch, counts, handle, a, b)
+    proof = prove_edge(edge, memory, scratch, counts, exits, a, b)
     if proof == EXIT_YES:
         remember_certified(lines, a, b)
         return True
@@ -302,14 +345,14 @@ def prove_edge(
     memory: EndMemory,
     scratch: EdgeScratch,
     counts: np.ndarray,
-    handle: int,
+    exits: SegmentExits,
     a: np.ndarray,
     b: np.ndarray,
 ) -> int:  # pragma: no cover (compiled)
     """The proof that ``a -> b`` is free: advancement, stopping at the first failure, then FCL
-    on the hard segments through the exit ``handle``; ``EXIT_YES`` (certified), ``EXIT_NO`` (a
-    contact, or a segment that cannot be certified) or ``EXIT_OVER_BUDGET``. Counts the
-    configurations evaluated and the distance queries in ``counts``.
+    on the hard segments through ``exits``; ``EXIT_YES`` (certified), ``EXIT_NO`` (a contact, a
+    segment that cannot be certified, or an error in the exit: ``counts[Count.RAISED]`` set) or
+    ``EXIT_OVER_BUDGET``. Counts the configurations evaluated and the distance queries in ``counts``.
 
     Where a non-convex pair's convex parts touch, the advancement stops at the end of that
     bisection level and FCL tests those segments for a contact first (most such edges collide
@@ -338,8 +381,13 @@ def prove_edge(
         if bad == 1.0:  # certified but for the hard segments
             break
         counts[Count.EXITS] += 1  # undecided at a touching segment: FCL looks there first
-        touching, used = hard_segments_touch(handle, a, b, hard_pair[:hard], hard_span[:hard], edge.budget - spent)
-        spent += used
+        touching = segments_exit(
+            exits, _SEGMENTS_TOUCH, a, b, hard_pair[:hard], hard_span[:hard], 0, 0, edge.budget - spent
+        )
+        spent += exits.numbers[WORK_SPENT]
+        if touching < 0:
+            counts[Count.RAISED] = 1
+            return EXIT_NO
         if touching == EXIT_OVER_BUDGET:
             return EXIT_OVER_BUDGET
         if touching != EXIT_NO:
@@ -347,36 +395,54 @@ def prove_edge(
     if hard == 0:
         return EXIT_YES
     counts[Count.EXITS] += 1
-    return hard_segments_free(handle, a, b, hard_pair[:hard], hard_span[:hard], start, end, edge.budget - spent)
-
-
-@njit(cache=True)
-def hard_segments_free(
-    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, start: int, end: int, left: int
-) -> int:  # pragma: no cover (compiled)
-    """The exit to the certifier behind ``handle``: FCL on the hard segments of ``a -> b`` with
-    ``left`` work units: :data:`EXIT_YES` (certified), :data:`EXIT_NO` or :data:`EXIT_OVER_BUDGET`."""
-    with objmode(free="int64"):
-        free = _exact(handle, a, b, pairs, spans, start, end, left)
+    free = segments_exit(
+        exits, _SEGMENTS_FREE, a, b, hard_pair[:hard], hard_span[:hard], start, end, edge.budget - spent
+    )
+    if free < 0:
+        counts[Count.RAISED] = 1
+        return EXIT_NO
     return free
 
 
 @njit(cache=True)
-def hard_segments_touch(
-    handle: int, a: np.ndarray, b: np.ndarray, pairs: np.ndarray, spans: np.ndarray, left: int
-) -> tuple[int, int]:  # pragma: no cover (compiled)
-    """The exit to the certifier behind ``handle``: whether FCL finds a contact in the hard segments
-    of ``a -> b`` with ``left`` work units (:data:`EXIT_YES`, :data:`EXIT_NO` or
-    :data:`EXIT_OVER_BUDGET`), and the work units it spent."""
-    with objmode(touching="int64", spent="int64"):
-        touching, spent = _touching(handle, a, b, pairs, spans, left)
-    return touching, spent
+def segments_exit(
+    exits: SegmentExits,
+    kind: int,
+    a: np.ndarray,
+    b: np.ndarray,
+    pairs: np.ndarray,
+    spans: np.ndarray,
+    start: int,
+    end: int,
+    left: int,
+) -> int:  # pragma: no cover (compiled)
+    """Ask the certifier behind ``exits`` query ``kind`` (:class:`Exit`: ``SEGMENTS_FREE`` or
+    ``SEGMENTS_TOUCH``) about the hard segments ``pairs`` (hard,), ``spans`` (hard, 4) of ``a ->
+    b``, with the end-memory rows ``start``, ``end`` and ``left`` work units: its answer, -1 when it
+    raised. The segments are staged ``len(exits.pairs)`` at a time, the parts before the last
+    kept by the certifier (``STAGE_SEGMENTS``); ``exits.numbers[WORK_SPENT]`` holds the work
+    units the query spent."""
+    exits.ends[0] = a
+    exits.ends[1] = b
+    numbers, total = exits.numbers, pairs.shape[0]
+    numbers[START_ROW], numbers[END_ROW], numbers[WORK_LEFT] = start, end, left
+    numbers[SEGMENTS], numbers[WORK_SPENT] = total, 0
+    rows, first = exits.pairs.shape[0], 0
+    while True:
+        count = min(rows, total - first)
+        exits.pairs[:count] = pairs[first : first + count]
+        exits.spans[:count] = spans[first : first + count]
+        first += count
+        if first == total:
+            return call_exit(exits.address, exits.handle, kind, count)
+        if call_exit(exits.address, exits.handle, _STAGE_SEGMENTS, count) < 0:
+            return -1
 
 
 @njit(cache=True)
 def certified_motion_free(view: CertifiedMotions, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover
     """The certified motion kernel of a :class:`CertifiedMotions` view (:func:`certified_edge_free`)."""
-    return certified_edge_free(view.edge, view.memory, view.lines, view.scratch, view.counts, view.handle, a, b)
+    return certified_edge_free(view.edge, view.memory, view.lines, view.scratch, view.counts, view.exits, a, b)
 
 
 register_kernels(RobotStates, state=robot_state_free)
@@ -386,7 +452,7 @@ register_kernels(CertifiedMotions, state="states", motion=certified_motion_free)
 
 def warm_stand_ins() -> tuple[Chain, Volumes, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The arrays of a :class:`RobotStates` view of a one-joint robot without geometry, but its
-    exit handle and counts: arguments of the types every robot passes."""
+    exit and counts: arguments of the types every robot passes."""
     from .screening import stand_ins
 
     chain, volumes = stand_ins()
@@ -416,7 +482,7 @@ def warm_up() -> None:
 
     chain, volumes = stand_ins()
     q = np.zeros(1)
-    states = RobotStates(*warm_stand_ins(), 0, new_counts())
+    states = RobotStates(*warm_stand_ins(), 0, 0, new_counts())  # (no exit: nothing to decide)
     robot_state_free(states, q)
     one = np.ones(1)
     layout = SpaceLayout(
@@ -460,51 +526,12 @@ def warm_up() -> None:
     scratch = EdgeScratch(
         np.zeros((0, 3)), np.zeros((4, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), np.zeros((1, 4))
     )
-    certified = CertifiedMotions(states, edge, end_memory(2, 1, 0), certified_lines(1, 1), scratch, 0, states.counts)
+    exits = SegmentExits(
+        0, 0, np.zeros((2, 1)), np.zeros(1, dtype=np.int64), np.zeros((1, 4)), np.zeros(NUMBERS, dtype=np.int64)
+    )
+    certified = CertifiedMotions(
+        states, edge, end_memory(2, 1, 0), certified_lines(1, 1), scratch, exits, states.counts
+    )
     certified_motion_free(certified, q, q)
     # (and the kernel the Python callers reach through the certifier's entry point)
-    certified_edge_free(edge, certified.memory, certified.lines, scratch, states.counts, 0, q, q)
-    warm_exits_once()
-
-
-class _AllFree:
-    """An exit target answering every query "free" (for :func:`warm_exits`)."""
-
-    def decide(self, *arguments: Any) -> bool:
-        return True
-
-    def hard_segments_free(self, *arguments: Any) -> bool:
-        return True
-
-    def hard_segments_touch(self, *arguments: Any) -> bool:
-        return False
-
-
-_EXITS_WARM = [False]
-
-
-def warm_exits_once() -> None:
-    """:func:`warm_exits`, the first time a process calls this."""
-    if not _EXITS_WARM[0]:
-        warm_exits()
-        _EXITS_WARM[0] = True
-
-
-def warm_exits() -> None:
-    """Run each exit to Python once: numba makes a kernel's ``objmode`` code ready the first
-    time it runs in a process (about a tenth of a second), which would otherwise fall on the
-    first FCL query of a solve. That readies it for the kernels compiled in the same process as
-    these (numba finds the block's code again by the identity it gave it when compiling); a
-    kernel compiled by another process, and cached, gets its block ready at its first exit (the
-    benchmark runner times such a solve again: :class:`~ompl_balance.bench.execution.NumbaCompiling`)."""
-    target = _AllFree()
-    handle = exit_handle(target)
-    q = np.zeros(1)
-    decide_screened(
-        RobotStates(*warm_stand_ins(), handle, np.zeros(len(Count), dtype=np.int64)),
-        np.zeros((2, 4, 4)),
-        np.zeros((0, 0), dtype=np.bool_),
-        np.zeros(0, dtype=np.bool_),
-    )
-    hard_segments_free(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)), 0, 1, 1)
-    hard_segments_touch(handle, q, q, np.zeros(0, dtype=np.int64), np.zeros((0, 4)), 1)
+    certified_edge_free(edge, certified.memory, certified.lines, scratch, states.counts, exits, q, q)

@@ -17,15 +17,19 @@ A view's class names the module of its kernels (:func:`kernels_in`), so that the
 imports them, and numba, only when it compiles for such a view.
 
 A query a kernel cannot decide in compiled code leaves through one exit, counted in
-``counts[Count.EXITS]``: FCL on a non-convex pair goes through the kernel's ``objmode`` block,
-which looks the Python object up by the integer handle the view carries (:func:`exit_handle`);
-a checker written in Python is called through a C callback
-(:mod:`ompl_balance.core.function_pointers`), once per tree's growth (an extension step, or
-all the steps of a connect) rather than once per state.
+``counts[Count.EXITS]``: a C callback (:data:`EXIT_ADDRESS`, :mod:`ompl_balance.core.function_pointers`)
+that calls ``answer(kind, count)`` of the Python object registered under the integer handle
+the view carries (:func:`exit_handle`). The kernel first writes what the query is about into
+arrays the object owns (an :class:`ExitTarget`'s staging arrays, also fields of the view), so
+the exit carries integers only. FCL on a non-convex pair goes out this way, and a checker
+written in Python is called this way once per tree's growth (an extension step, or all the
+steps of a connect) rather than once per state. Nothing of an exit is compiled when it is
+first taken: it costs the same in every process.
 
-A check that raises (a user's function) cannot raise through compiled code: its kernel sets
-``counts[Count.RAISED]`` and answers "not valid"; the engine stops at once and has the object
-that kept the error raise it in Python.
+A check that raises (a user's function, FCL, a Ctrl-C in an exit) cannot raise through compiled
+code: its kernel sets ``counts[Count.RAISED]`` and answers "not valid"; the engine stops at
+once and has the object that kept the error raise it in Python (:func:`raise_kept`, for the
+Python callers of the kernels).
 """
 
 from __future__ import annotations
@@ -141,6 +145,35 @@ def _exit(handle: int, kind: int, count: int) -> int:
     except BaseException as error:
         target.error = error
         return -1
+
+
+class ExitTarget:
+    """An object compiled code asks through the exit: its ``answer(kind, count)`` reads the query
+    from arrays it owns, which the kernel filled; an error it raises is kept in :attr:`error`
+    (the exit returns -1, the kernel sets ``counts[Count.RAISED]``) and raised by
+    :meth:`raise_error` once the compiled code has returned."""
+
+    error: BaseException | None = None
+
+    def answer(self, kind: int, count: int) -> int:
+        raise NotImplementedError
+
+    def raise_error(self) -> None:
+        """Raise the error an exit kept, forgetting it (nothing when none was kept)."""
+        error, self.error = self.error, None
+        if error is not None:
+            raise error
+
+
+def raise_kept(counts: np.ndarray, *targets: ExitTarget) -> None:
+    """After a Python call of compiled kernels that exit to ``targets`` and count in ``counts``:
+    when a kernel met an error (``counts[Count.RAISED]``), clear the flag and raise the error the
+    target kept."""
+    if counts[Count.RAISED]:
+        counts[Count.RAISED] = 0
+        for target in targets:
+            target.raise_error()
+        raise RuntimeError("a check failed in compiled code and left no error to report")
 
 
 _EXIT = EXIT_SIGNATURE(_exit)  # kept for the life of the process

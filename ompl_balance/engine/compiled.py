@@ -28,7 +28,7 @@ from typing import Any
 from ompl import base as ob
 from ompl import util as ou
 
-from ..core.checks import kernel_modules
+from ..core.checks import load_kernels
 from ..core.file_lock import file_lock
 from ..core.layout import SpaceLayout
 from ..core.spaces import ArrayPoints
@@ -75,7 +75,7 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
     (:mod:`ompl_balance.engine.compile_worker`; a compilation takes tens of seconds, mostly in
     Python, and would hold this interpreter), then loaded; compiled here in a process that only
     compiles (:func:`compile_in_this_process`)."""
-    modules = [importlib.import_module(module) for module in kernel_modules(view)]
+    load_kernels(view)
     from ..core.compiled_calls import load_cached, signature_of  # (these import numba)
     from ..core.kernel_cache import package_digest
     from . import loop
@@ -99,10 +99,6 @@ def _warm(view: Any, layout: SpaceLayout) -> None:
         except (OSError, subprocess.SubprocessError, pickle.PicklingError):
             pass  # compiled here instead
     driver.warm_up(view, layout)
-    for module in modules:  # the exits to Python, run once (see their warm_exits)
-        warm_exits = getattr(module, "warm_exits", None)
-        if warm_exits is not None:
-            warm_exits()
 
 
 @functools.cache

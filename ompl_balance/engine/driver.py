@@ -235,8 +235,8 @@ def interrupts_between_slices(exits: bool) -> contextlib.AbstractContextManager[
     the last call.
 
     Python runs a signal's handler wherever its interpreter next runs, which in a compiled
-    slice is inside a kernel's ``objmode`` exit to Python; numba does not carry an exception out
-    of there safely (a process could crash). So while a solve whose kernels may call Python
+    slice is inside a kernel's exit to Python, where the ``KeyboardInterrupt`` would become the
+    error of the check in progress. So while a solve whose kernels may call Python
     (``exits``) runs, SIGINT only sets a flag, where the process handles it in Python (main
     thread only: Python delivers signals there). Without exits the interpreter next runs after
     the slice, where ``KeyboardInterrupt`` is safe, and the handler stays as it was; so it does

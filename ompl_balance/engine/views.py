@@ -92,7 +92,7 @@ class EngineChecks:
     only for what they cannot decide) or ``"python"`` (the space information's checkers, called
     through an exit). ``source``: the objects it was made from (validity checker, motion
     validator, their compiled view, the layout), by identity. ``exits``: whether its kernels may
-    call Python through numba's ``objmode`` (see :func:`~ompl_balance.core.checks.exits_to_python`).
+    call Python (see :func:`~ompl_balance.core.checks.exits_to_python`).
     ``reporter``: the object that raises an error a check kept (its ``raise_error()``), if any.
     ``steps_together``: whether its kernels check a tree's steps in one call to Python (a
     batched :class:`~ompl_balance.core.exit_checks.ExitChecks`), so the loop lays a whole

@@ -36,6 +36,7 @@ import fcl
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ...core.checks import ExitTarget, raise_kept
 from ...core.compiled_calls import entry_point
 from ..advancement import DISTANCE_TOLERANCE
 from ..bisection import bisect_segments, contact_at_middles
@@ -47,7 +48,7 @@ from ..environment import Environment
 from ..geometry import Shape, fcl_transform
 from .advance import LAST_VALID_TRAVEL, MIN_TRAVEL, edge_status
 from .body import RigidBody
-from .kernels import RigidStates, probe_free, rigid_states
+from .kernels import Exit, RigidStates, probe_free, rigid_states
 from .motion import interpolate, motion_split, state_pose, valid_state
 from .pieces import soup_mesh
 from .view import (
@@ -73,7 +74,7 @@ _DISTANCE_REQUEST = fcl.DistanceRequest()
 END_DISTANCES_KEPT = 1024
 
 
-class RigidBodyChecker:
+class RigidBodyChecker(ExitTarget):
     """Collision checks and certified motions of a rigid body among static obstacles.
 
     Parameters
@@ -248,8 +249,11 @@ class RigidBodyChecker:
         self.counter.motions_checked += 1
         if not self.prefilter:
             return self._finish_edge(a, b, self._whole_edge(), 1.0, False, last_valid, WorkBudget(self.view.budget))
-        if self.view.probe and not last_valid and not self._probe_kernel(self._states_view, a, b):
-            return False, 0.0
+        if self.view.probe and not last_valid:
+            probed_free = self._probe_kernel(self._states_view, a, b)
+            raise_kept(self.counter.array, self)
+            if not probed_free:
+                return False, 0.0
         status, fraction = self._edge_kernel(self.view, a, b, last_valid)
         self._count_kernel_work()
         if status == FREE:
@@ -327,6 +331,16 @@ class RigidBodyChecker:
     def inside_bounds(self, state: ArrayLike) -> bool:
         """Whether ``state`` is a valid state within the position bounds (collisions aside)."""
         return bool(valid_state(self._row(state), self.view.low, self.view.high))
+
+    def answer(self, kind: int, count: int) -> int:
+        """The exit's answer (:class:`~ompl_balance.collision.rigid.kernels.Exit`): :meth:`decide`
+        of the state or motion the kernel staged in its view, 1 free, 0 not."""
+        staged = self._states_view.staged
+        if kind == Exit.DECIDE_STATE:
+            return int(self.decide(staged[0])[0])
+        if kind == Exit.DECIDE_MOTION:
+            return int(self.decide(staged[0].copy(), staged[1].copy())[0])
+        raise ValueError(f"a rigid-body checker answers the queries of Exit, not query {kind}")
 
     def kernel_view(self) -> RigidStates | None:
         """The checker as compiled code sees it (:class:`~ompl_balance.collision.rigid.kernels.RigidStates`),

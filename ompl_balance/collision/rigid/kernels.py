@@ -5,19 +5,22 @@ check) and :class:`RigidCertifiedMotions` (its certified motions) are the views 
 takes from the rigid-body validators (:mod:`ompl_balance.core.checks`): the screening
 (:func:`~ompl_balance.collision.rigid.view.state_status`) and the certified edge
 (:func:`~ompl_balance.collision.rigid.advance.edge_status`) run compiled, and what they leave
-undecided leaves through one counted exit to the checker's :meth:`decide` (FCL). The counts go
-to the checker's own work counter, as its Python methods count.
+undecided leaves through one counted exit to the checker's :meth:`decide` (FCL), a C callback
+(:mod:`ompl_balance.core.checks`) whose states are staged in the view's ``staged`` array (an error
+in it sets ``counts[Count.RAISED]``). The counts go to the checker's own work counter, as its
+Python methods count.
 """
 
 from __future__ import annotations
 
+import enum
 from typing import Any, NamedTuple
 
 import numpy as np
-from numba import objmode
 
 from ...core.check_overloads import register_kernels
-from ...core.checks import Count, exit_handle, exit_target, kernels_in
+from ...core.checks import EXIT_ADDRESS, Count, exit_handle, kernels_in
+from ...core.function_pointers import call_exit
 from ...core.kernel_cache import njit
 from .advance import edge_status
 from .motion import interpolate, motion_split
@@ -29,14 +32,29 @@ class RigidStates(NamedTuple):
     """A rigid-body checker's state check as compiled code sees it.
 
     ``rigid``: the checker's :class:`~ompl_balance.collision.rigid.view.RigidView` (geometry and
-    scratch, shared with its Python methods); ``handle``: the exit to the checker
-    (:func:`~ompl_balance.core.checks.exit_target`); ``counts``: its work counter's array
-    (indexed by :class:`~ompl_balance.core.checks.Count`).
+    scratch, shared with its Python methods); ``staged`` (2, state size): the states of a query
+    to the checker, which it reads; ``address`` and ``handle``: the exit to the checker
+    (:class:`Exit`); ``counts``: its work counter's array (indexed by
+    :class:`~ompl_balance.core.checks.Count`).
     """
 
     rigid: RigidView  # (a field named "view" would clash with numba's array method)
+    staged: np.ndarray
+    address: int
     handle: int
     counts: np.ndarray
+
+
+class Exit(enum.IntEnum):
+    """What the rigid-body kernels' exits ask the checker: FCL on what the last kernel call left of
+    the state ``staged[0]`` (``DECIDE_STATE``), or of the motion ``staged[0] -> staged[1]``
+    (``DECIDE_MOTION``): 1 free, 0 not."""
+
+    DECIDE_STATE = 0
+    DECIDE_MOTION = 1
+
+
+_DECIDE_STATE, _DECIDE_MOTION = int(Exit.DECIDE_STATE), int(Exit.DECIDE_MOTION)  # (for compiled code)
 
 
 @kernels_in("ompl_balance.collision.rigid.kernels")
@@ -49,33 +67,25 @@ class RigidCertifiedMotions(NamedTuple):
 
 
 def rigid_states(checker: Any) -> RigidStates:
-    """The :class:`RigidStates` view of a :class:`~ompl_balance.collision.rigid.checker.RigidBodyChecker`."""
-    return RigidStates(checker.view, exit_handle(checker), checker.counter.array)
-
-
-def _decide_state(handle: int, state: np.ndarray) -> bool:
-    return bool(exit_target(handle).decide(state)[0])
-
-
-def _decide_motion(handle: int, a: np.ndarray, b: np.ndarray) -> bool:
-    return bool(exit_target(handle).decide(a, b)[0])
+    """The :class:`RigidStates` view of a :class:`~ompl_balance.collision.rigid.checker.RigidBodyChecker`
+    (the checker makes it once: its exit reads this view's ``staged`` states)."""
+    staged = np.zeros((2, checker.body.state_size))
+    return RigidStates(checker.view, staged, EXIT_ADDRESS, exit_handle(checker), checker.counter.array)
 
 
 @njit(cache=True)
-def decide_state(handle: int, state: np.ndarray) -> bool:  # pragma: no cover (compiled)
-    """The exit to the checker behind ``handle``: FCL on the pairs the screening of ``state`` left."""
-    with objmode(free="boolean"):
-        free = _decide_state(handle, state)
-    return free
-
-
-@njit(cache=True)
-def decide_motion(handle: int, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover (compiled)
-    """The exit to the checker behind ``handle``: FCL distances on the segments of ``a -> b`` the
-    certified edge left."""
-    with objmode(free="boolean"):
-        free = _decide_motion(handle, a, b)
-    return free
+def decide(view: RigidStates, kind: int, a: np.ndarray, b: np.ndarray) -> bool:  # pragma: no cover (compiled)
+    """The exit to the checker: FCL on what the last kernel call left of the state ``a``
+    (``Exit.DECIDE_STATE``; ``b`` unused) or of the motion ``a -> b`` (``Exit.DECIDE_MOTION``);
+    counts the exit. ``False`` with ``counts[Count.RAISED]`` set when the checker raised."""
+    view.counts[Count.EXITS] += 1
+    view.staged[0] = a
+    view.staged[1] = b
+    answer = call_exit(view.address, view.handle, kind, 0)
+    if answer < 0:
+        view.counts[Count.RAISED] = 1
+        return False
+    return answer == 1
 
 
 @njit(cache=True)
@@ -85,8 +95,7 @@ def rigid_state_free(view: RigidStates, state: np.ndarray) -> bool:  # pragma: n
     status = state_status(view.rigid, state)
     if status != UNDECIDED:
         return status == FREE
-    view.counts[Count.EXITS] += 1
-    return decide_state(view.handle, state)
+    return decide(view, _DECIDE_STATE, state, state)
 
 
 #: At most this many states probe a motion (:func:`probe_free`).
@@ -119,7 +128,7 @@ def probe_free(view: RigidStates, a: np.ndarray, b: np.ndarray) -> bool:  # prag
         for j in range(1, denominator, 2):
             interpolate(a, b, j / denominator, state)
             if not rigid_state_free(view, state):
-                return False
+                return False  # (also when the exit raised: the caller looks at counts)
         denominator *= 2
     return True
 
@@ -143,26 +152,8 @@ def rigid_certified_motion_free(
     counts[Count.OVER_BUDGET] += rigid.counts[OVER_BUDGET]
     if status != UNDECIDED:
         return status == FREE
-    counts[Count.EXITS] += 1
-    return decide_motion(states.handle, a, b)
+    return decide(states, _DECIDE_MOTION, a, b)
 
 
 register_kernels(RigidStates, state=rigid_state_free)
 register_kernels(RigidCertifiedMotions, state="states", motion=rigid_certified_motion_free)
-
-
-class _AllFree:
-    """An exit target answering every query "free" (for :func:`warm_exits`)."""
-
-    def decide(self, *arguments: Any) -> tuple[bool, float]:
-        return True, 1.0
-
-
-def warm_exits() -> None:
-    """Run the exits to Python once: numba makes a kernel's ``objmode`` code ready the first time
-    it runs in a process (about a tenth of a second), which would otherwise fall in a solve (for
-    the kernels compiled in the same process as these: see the robot kernels' ``warm_exits``)."""
-    target = _AllFree()  # held here: the registry holds it weakly
-    handle, q = exit_handle(target), np.zeros(3)
-    decide_state(handle, q)
-    decide_motion(handle, q, q)
