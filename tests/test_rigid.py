@@ -534,7 +534,7 @@ def test_an_error_in_fcl_reaches_the_caller_and_the_planner_plans_on(monkeypatch
     ss = problem.simple_setup(checker=checker)
     planner = BalancedRRTConnect(ss.getSpaceInformation())
     planner.setEngine("compiled")
-    planner.params().setParam("seed", "1")  # (its solve reaches FCL: 163 exits)
+    planner.params().setParam("seed", "1")  # (its solve reaches FCL: 16 exits)
     ss.setPlanner(planner)
     with monkeypatch.context() as patched:
         patched.setattr(checker, "decide", failing_fcl)
