@@ -102,16 +102,12 @@ from .certified_lines import LINES_REMEMBERED, along_certified, certified_lines,
 from .checker import CollisionChecker
 from .convex import convex_part, pack_parts
 from .kernels import (
-    END_ROW,
     EXIT_NO,
     EXIT_OVER_BUDGET,
     EXIT_YES,
-    SEGMENTS,
-    START_ROW,
-    WORK_LEFT,
-    WORK_SPENT,
     CertifiedMotions,
     Exit,
+    Staged,
     certified_edge_free,
     segment_exits,
 )
@@ -352,15 +348,15 @@ class MotionCertifier(ExitTarget):
             self._staged.append((pairs, spans))
             return 0
         if self._staged:  # (the query's own parts are the last ``total`` rows)
-            total = int(exits.numbers[SEGMENTS])
+            total = int(exits.numbers[Staged.SEGMENTS])
             pairs = np.concatenate([part for part, _ in self._staged] + [pairs])[-total:]
             spans = np.concatenate([part for _, part in self._staged] + [spans])[-total:]
             self._staged.clear()
         a, b = exits.ends[0].copy(), exits.ends[1].copy()
-        budget = WorkBudget(int(exits.numbers[WORK_LEFT]))
+        budget = WorkBudget(int(exits.numbers[Staged.WORK_LEFT]))
         try:
             if kind == Exit.SEGMENTS_FREE:
-                start, end = int(exits.numbers[START_ROW]), int(exits.numbers[END_ROW])
+                start, end = int(exits.numbers[Staged.START_ROW]), int(exits.numbers[Staged.END_ROW])
                 free = self.hard_segments_free(a, b, pairs, spans, start, end, budget)
                 return EXIT_YES if free else EXIT_OVER_BUDGET if budget.exhausted else EXIT_NO
             if kind == Exit.SEGMENTS_TOUCH:
@@ -368,7 +364,7 @@ class MotionCertifier(ExitTarget):
         except OverBudgetError:
             return EXIT_OVER_BUDGET
         finally:
-            exits.numbers[WORK_SPENT] = budget.spent
+            exits.numbers[Staged.WORK_SPENT] = budget.spent
         raise ValueError(f"a motion certifier answers the segment queries of Exit, not query {kind}")
 
     def hard_segments_free(

@@ -255,9 +255,8 @@ class SegmentExits(NamedTuple):
 
     ``address`` and ``handle``: the exit to the certifier (:class:`Exit`); ``ends`` (2, dof): the
     edge's ends; ``pairs`` (rows,) and ``spans`` (rows, 4): hard segments, ``(pair, (t0, t1, d0,
-    d1))`` (more than ``rows`` go in parts: :func:`segments_exit`); ``numbers`` (:data:`NUMBERS`,)
-    int64: the end-memory rows of the ends, the work units left, the segments in all, and the work
-    units the exit spent (its answer).
+    d1))`` (more than ``rows`` go in parts: :func:`segments_exit`); ``numbers`` (:class:`Staged`)
+    int64: the query's numbers.
     """
 
     address: int
@@ -268,9 +267,14 @@ class SegmentExits(NamedTuple):
     numbers: np.ndarray
 
 
-#: The entries of :attr:`SegmentExits.numbers`.
-START_ROW, END_ROW, WORK_LEFT, SEGMENTS, WORK_SPENT = range(5)
-NUMBERS = 5
+class Staged(enum.IntEnum):
+    """The entries of :attr:`SegmentExits.numbers`."""
+
+    START_ROW = 0  # the end memory's rows of the edge's ends
+    END_ROW = 1
+    WORK_LEFT = 2  # the work units the query may spend
+    SEGMENTS = 3  # the segments of the query, in all its parts
+    WORK_SPENT = 4  # the work units it spent (its answer)
 
 
 def segment_exits(certifier: Any, dof: int, rows: int) -> SegmentExits:
@@ -284,7 +288,7 @@ def segment_exits(certifier: Any, dof: int, rows: int) -> SegmentExits:
         np.zeros((2, dof)),
         np.zeros(rows, dtype=np.int64),
         np.zeros((rows, 4)),
-        np.zeros(NUMBERS, dtype=np.int64),
+        np.zeros(len(Staged), dtype=np.int64),
     )
 
 
@@ -384,7 +388,7 @@ def prove_edge(
         touching = segments_exit(
             exits, _SEGMENTS_TOUCH, a, b, hard_pair[:hard], hard_span[:hard], 0, 0, edge.budget - spent
         )
-        spent += exits.numbers[WORK_SPENT]
+        spent += exits.numbers[Staged.WORK_SPENT]
         if touching < 0:
             counts[Count.RAISED] = 1
             return EXIT_NO
@@ -420,13 +424,13 @@ def segments_exit(
     ``SEGMENTS_TOUCH``) about the hard segments ``pairs`` (hard,), ``spans`` (hard, 4) of ``a ->
     b``, with the end-memory rows ``start``, ``end`` and ``left`` work units: its answer, -1 when it
     raised. The segments are staged ``len(exits.pairs)`` at a time, the parts before the last
-    kept by the certifier (``STAGE_SEGMENTS``); ``exits.numbers[WORK_SPENT]`` holds the work
+    kept by the certifier (``STAGE_SEGMENTS``); ``exits.numbers[Staged.WORK_SPENT]`` holds the work
     units the query spent."""
     exits.ends[0] = a
     exits.ends[1] = b
     numbers, total = exits.numbers, pairs.shape[0]
-    numbers[START_ROW], numbers[END_ROW], numbers[WORK_LEFT] = start, end, left
-    numbers[SEGMENTS], numbers[WORK_SPENT] = total, 0
+    numbers[Staged.START_ROW], numbers[Staged.END_ROW], numbers[Staged.WORK_LEFT] = start, end, left
+    numbers[Staged.SEGMENTS], numbers[Staged.WORK_SPENT] = total, 0
     rows, first = exits.pairs.shape[0], 0
     while True:
         count = min(rows, total - first)
@@ -527,7 +531,7 @@ def warm_up() -> None:
         np.zeros((0, 3)), np.zeros((4, 3)), np.zeros(0), np.zeros(1, dtype=np.int64), np.zeros((1, 4))
     )
     exits = SegmentExits(
-        0, 0, np.zeros((2, 1)), np.zeros(1, dtype=np.int64), np.zeros((1, 4)), np.zeros(NUMBERS, dtype=np.int64)
+        0, 0, np.zeros((2, 1)), np.zeros(1, dtype=np.int64), np.zeros((1, 4)), np.zeros(len(Staged), dtype=np.int64)
     )
     certified = CertifiedMotions(
         states, edge, end_memory(2, 1, 0), certified_lines(1, 1), scratch, exits, states.counts

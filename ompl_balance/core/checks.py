@@ -107,8 +107,8 @@ _HANDLES = itertools.count(1)
 
 
 def exit_handle(target: Any) -> int:
-    """The handle by which compiled code reaches ``target`` (see :func:`exit_target`): one per
-    object, held weakly, so registering keeps nothing alive."""
+    """The handle by which compiled code reaches ``target`` through the exit (:data:`EXIT_ADDRESS`):
+    one per object, held weakly, so registering keeps nothing alive."""
     handle = _HANDLE_OF.get(target)
     if handle is None:
         handle = next(_HANDLES)
@@ -119,14 +119,6 @@ def exit_handle(target: Any) -> int:
 
 def _forget(handle: int, reference: weakref.ref[Any]) -> None:
     _TARGETS.pop(handle, None)
-
-
-def exit_target(handle: int) -> Any:
-    """The object registered under ``handle``, for a kernel's exit (``KeyError`` once it is gone)."""
-    target = _TARGETS[handle]()
-    if target is None:
-        raise KeyError(handle)
-    return target
 
 
 #: C signature of an exit: ``int64 exit(int64 handle, int64 kind, int64 count)``.
