@@ -1,5 +1,8 @@
 """Collision answers against an independent FCL query, and the OMPL adapters against OMPL's own."""
 
+import json
+import subprocess
+import sys
 from pathlib import Path
 
 import fcl
@@ -19,6 +22,8 @@ from ompl_balance.collision.robots import PANDA_VAMP_DIR, load_panda_vamp
 from ompl_balance.core.counting import read_work
 from ompl_balance.validity import MotionValidator, StateValidityChecker, setup_robot, space_for
 from ompl_balance.worlds.mbm import load_mbm
+
+REPO = Path(__file__).resolve().parents[1]
 
 ROBOTS = Path(__file__).resolve().parent / "robots"
 
@@ -363,3 +368,50 @@ def test_an_error_in_fcl_reaches_the_caller_and_the_planner_plans_on(motion, eng
     assert ss.solve(10.0)
     path = ss.getSolutionPath()
     assert checker.check(np.array([path.getState(i)[0:3] for i in range(path.getStateCount())])).all()
+
+
+FIRST_FCL_QUERIES = """
+import json, sys
+import numpy as np
+from numba.core import event
+from ompl import geometric as og, util as ou
+ou.setLogLevel(ou.LOG_ERROR)
+sys.path.insert(0, "tests")
+from test_validity import arm3_scene, state_fcl_decides
+from ompl_balance import BalancedRRTConnect
+from ompl_balance.collision.checker import CollisionChecker
+from ompl_balance.validity import setup_robot, space_for
+robot, environment, _ = arm3_scene()
+compiling = event.TimingListener()
+with event.install_listener("numba:compile", compiling):
+    checker = CollisionChecker(robot, environment)
+    state_fcl_decides(checker, np.random.default_rng(5))
+    ss = og.SimpleSetup(space_for(robot))
+    setup_robot(ss, checker, motion="certified")
+    si = ss.getSpaceInformation()
+    start, goal = si.allocState(), si.allocState()
+    for i, (a, b) in enumerate(zip([0.0, -1.0, 0.1], [2.5, 1.0, 0.1])):
+        start[i], goal[i] = a, b
+    ss.setStartAndGoalStates(start, goal)
+    planner = BalancedRRTConnect(si)
+    planner.setEngine("compiled")
+    planner.params().setParam("seed", "2")
+    ss.setPlanner(planner)
+    ss.setup()
+    planner.wait_for_engine()
+    before = checker.counter.exits
+    solved = bool(ss.solve(10.0))
+print(json.dumps({"compiled": compiling.done, "solved": solved, "exits": [before, checker.counter.exits - before]}))
+"""
+
+
+def test_a_fresh_process_compiles_nothing_at_its_first_fcl_queries():
+    """A process whose kernels and engine numba's cache holds takes its first FCL queries, from a
+    Python check and from a compiled solve, without numba compiling anything (an exit is a C
+    callback, nothing of it is compiled lazily). The first run fills the cache where it is cold."""
+    command = [sys.executable, "-c", FIRST_FCL_QUERIES]
+    subprocess.run(command, capture_output=True, text=True, timeout=900, cwd=REPO, check=True)
+    result = subprocess.run(command, capture_output=True, text=True, timeout=300, cwd=REPO, check=True)
+    answer = json.loads(result.stdout.strip().splitlines()[-1])
+    assert answer["solved"] and answer["exits"][0] >= 1 and answer["exits"][1] >= 1
+    assert not answer["compiled"], "numba compiled in a process whose kernels were cached"

@@ -167,9 +167,9 @@ class NumbaCompiling:
     numba is not loaded, as then nothing compiles), measured by numba's event API.
 
     A compilation inside a timed solve is the first call of some compiled code in the run's
-    process that its warm-up did not make (an exit to Python that the warm-up's solve never
-    took, a user's function compiled at its first call), which numba keeps for the process: it
-    is the process's start, not planning (see :func:`execute`)."""
+    process that its warm-up did not make (such as a user's function compiled at its first
+    call), which numba keeps for the process: it is the process's start, not planning (see
+    :func:`execute`)."""
 
     def __init__(self) -> None:
         self.seconds = 0.0
