@@ -239,15 +239,29 @@ def robot_discrete_motion_free(view: RobotDiscreteMotions, a: np.ndarray, b: np.
             q[k, j] = a[j] + t * (b[j] - a[j])
     view.counts[Count.STATES] += rows
     maybe = screen(q[:rows], view.states.chain, view.states.volumes, poses, obstacle_hits, self_hits)
-    states = view.states
     for k in range(rows):
         if maybe[k]:
-            states.poses[0] = poses[k]  # (what the checker's exit reads)
-            states.obstacle_hits[0] = obstacle_hits[k]
-            states.self_hits[0] = self_hits[k]
-            if not decide_screened(states):
+            _stage_screened(view.states, poses, obstacle_hits, self_hits, k)
+            if not decide_screened(view.states):
                 return False
     return True
+
+
+@njit(cache=True)
+def _stage_screened(
+    view: RobotStates, poses: np.ndarray, obstacle_hits: np.ndarray, self_hits: np.ndarray, k: int
+) -> None:  # pragma: no cover (compiled)
+    """Row ``k`` of a batch's screening arrays into the view's one-row arrays, which the checker's
+    exit reads (element by element: see :func:`segments_exit`)."""
+    for body in range(poses.shape[1]):
+        for i in range(4):
+            for j in range(4):
+                view.poses[0, body, i, j] = poses[k, body, i, j]
+    for o in range(obstacle_hits.shape[1]):
+        for g in range(obstacle_hits.shape[2]):
+            view.obstacle_hits[0, o, g] = obstacle_hits[k, o, g]
+    for pair in range(self_hits.shape[1]):
+        view.self_hits[0, pair] = self_hits[k, pair]
 
 
 class SegmentExits(NamedTuple):
@@ -425,17 +439,21 @@ def segments_exit(
     b``, with the end-memory rows ``start``, ``end`` and ``left`` work units: its answer, -1 when it
     raised. The segments are staged ``len(exits.pairs)`` at a time, the parts before the last
     kept by the certifier (``STAGE_SEGMENTS``); ``exits.numbers[Staged.WORK_SPENT]`` holds the work
-    units the query spent."""
-    exits.ends[0] = a
-    exits.ends[1] = b
+    units the query spent. (Arrays are copied element by element: an array assigned to a slice
+    has numba compile its shape-mismatch error, seconds of compiling.)"""
+    for j in range(a.shape[0]):
+        exits.ends[0, j] = a[j]
+        exits.ends[1, j] = b[j]
     numbers, total = exits.numbers, pairs.shape[0]
     numbers[Staged.START_ROW], numbers[Staged.END_ROW], numbers[Staged.WORK_LEFT] = start, end, left
     numbers[Staged.SEGMENTS], numbers[Staged.WORK_SPENT] = total, 0
     rows, first = exits.pairs.shape[0], 0
     while True:
         count = min(rows, total - first)
-        exits.pairs[:count] = pairs[first : first + count]
-        exits.spans[:count] = spans[first : first + count]
+        for i in range(count):
+            exits.pairs[i] = pairs[first + i]
+            for j in range(4):
+                exits.spans[i, j] = spans[first + i, j]
         first += count
         if first == total:
             return call_exit(exits.address, exits.handle, kind, count)

@@ -79,8 +79,9 @@ def decide(view: RigidStates, kind: int, a: np.ndarray, b: np.ndarray) -> bool: 
     (``Exit.DECIDE_STATE``; ``b`` unused) or of the motion ``a -> b`` (``Exit.DECIDE_MOTION``);
     counts the exit. ``False`` with ``counts[Count.RAISED]`` set when the checker raised."""
     view.counts[Count.EXITS] += 1
-    view.staged[0] = a
-    view.staged[1] = b
+    for j in range(a.shape[0]):  # (element by element: see collision.kernels.segments_exit)
+        view.staged[0, j] = a[j]
+        view.staged[1, j] = b[j]
     answer = call_exit(view.address, view.handle, kind, 0)
     if answer < 0:
         view.counts[Count.RAISED] = 1
