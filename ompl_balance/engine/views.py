@@ -26,14 +26,14 @@ from typing import Any
 import numpy as np
 from ompl import base as ob
 
-from ..core.checks import Count, exits_to_python, new_counts
+from ..core.checks import Count, ExitTarget, exits_to_python, new_counts
 from ..core.counting import CountingValidityChecker, validity
 from ..core.discrete_motions import discrete_motions
 from ..core.exit_checks import ExitChecks, Query, chunks_up_to, exit_checks
 from ..core.layout import SpaceLayout
 
 
-class SpaceChecks:
+class SpaceChecks(ExitTarget):
     """The target of the exits of a space information's checks: its checkers on flat states
     (:class:`~ompl_balance.core.exit_checks.ExitChecks`; an error it raises is kept in :attr:`error`).
 
@@ -74,12 +74,6 @@ class SpaceChecks:
         copy(start, rows[0].tolist())
         copy(end, rows[1].tolist())
         return int(self._si.checkMotion(start, end))
-
-    def raise_error(self) -> None:
-        """Raise the error an exit kept, forgetting it."""
-        error, self.error = self.error, None
-        if error is not None:
-            raise error
 
 
 _STATES = int(Query.STATES)
