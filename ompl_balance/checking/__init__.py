@@ -22,10 +22,10 @@ package's planners do with each (:mod:`ompl_balance.checking.functions`):
 * a numba function (``@numba.njit``) or ``cfunc``: the compiled engine calls it for every
   state with no Python in between, and is not compiled again for a new function;
 * ``vectorized=True``, a numpy function of an ``(n, d)`` array returning ``n`` booleans: called
-  once per growth of a tree (an extension step; all the steps of a connect) with all the states
-  OMPL's rule would test;
+  once per iteration of the loop (its extension step, then all the steps of the connect after
+  it) with all the states OMPL's rule would test;
 * any other Python function of ``q``: called for each state, from one call into Python per
-  growth of a tree.
+  iteration.
 
 Stock planners call the same checker and validator (one call into Python per state, or per
 motion for the validator). ``docs/checkers.md`` measures each kind.

@@ -11,12 +11,12 @@ returns a :class:`CheckFunction`, one of four kinds (:data:`KINDS`):
     a numba ``cfunc`` of signature ``boolean(CPointer(float64), intp)`` (the state's values and
     their number): the engine calls its address as it is (a ``cfunc`` cannot report an error);
 ``vectorized``
-    ``fn(Q) -> (n,) bools`` of an ``(n, d)`` float64 array: called once per growth of a tree
-    (an extension step's motion; all the steps of a connect) with every state OMPL's discrete
-    rule would test;
+    ``fn(Q) -> (n,) bools`` of an ``(n, d)`` float64 array: called once per iteration of the
+    loop (its extension step, then all the steps of the connect after it) with every state
+    OMPL's discrete rule would test;
 ``python``
     any other callable ``fn(q) -> bool`` of a 1-D float64 array: called once per state, from
-    one call into Python per growth of a tree.
+    one call into Python per iteration.
 
 ``q`` holds the state's values in the flat layout of :mod:`ompl_balance.core.layout` (OMPL's
 ``copyFromReals`` order). A function's error reaches the caller as a :class:`CheckerError`

@@ -4,7 +4,8 @@ A checker that can be called from compiled code offers a *view*: a ``NamedTuple`
 arrays (its obstacles, its robot, its scratch space, ...) whose type has compiled
 implementations of :func:`state_free` and :func:`motion_free`, registered with
 ``numba.extending.overload`` by the module that defines the view (and, where checking a
-tree's steps together pays, of :func:`steps_free`; other views check them one by one). The
+tree's steps together pays, of :func:`steps_free` and :func:`growth_free`; other views check
+them one by one). The
 compiled planning engine (:mod:`ompl_balance.engine`) calls them on flat states
 (:mod:`ompl_balance.core.layout`) without knowing which checker is behind the view; numba
 compiles the engine once per type of view and caches it on disk.
@@ -22,8 +23,8 @@ that calls ``answer(kind, count)`` of the Python object registered under the int
 the view carries (:func:`exit_handle`). The kernel first writes what the query is about into
 arrays the object owns (an :class:`ExitTarget`'s staging arrays, also fields of the view), so
 the exit carries integers only. FCL on a non-convex pair goes out this way, and a checker
-written in Python is called this way once per tree's growth (an extension step, or all the
-steps of a connect) rather than once per state. Nothing of an exit is compiled when it is
+written in Python is called this way once per iteration of the loop (its extension step and
+the connect after it) rather than once per state. Nothing of an exit is compiled when it is
 first taken: it costs the same in every process.
 
 A check that raises (a user's function, FCL, a Ctrl-C in an exit) cannot raise through compiled
@@ -99,6 +100,27 @@ def steps_free(view: Any, chain: np.ndarray, steps: int, outward: bool) -> int:
     them one by one with its ``state_free`` and ``motion_free``.
     """
     raise TypeError("steps_free is a compiled kernel: call it from numba-compiled code with a checker's view")
+
+
+#: What :func:`growth_free` answers when the extension itself is blocked.
+EXTENSION_BLOCKED = -1
+
+
+def growth_free(
+    view: Any, extension: np.ndarray, extension_outward: bool, chain: np.ndarray, steps: int, outward: bool
+) -> int:
+    """An iteration's growth checked at once (compiled code only): one tree's extension step
+    ``extension[0] -> extension[1]`` (``extension_outward``: the start tree's), then, when it is
+    free, the other tree's connect steps ``chain[0] -> ... -> chain[steps]`` towards
+    ``extension[1]`` (``outward``), each checked as :func:`steps_free` checks a step. Returns how
+    many of the connect's steps are free, or :data:`EXTENSION_BLOCKED`.
+
+    The checks stop at the first blocked step, so the states tested and counted are those of
+    checking the extension and then the connect step by step. A view may check them all in one
+    exit to Python (:mod:`ompl_balance.core.exit_check_kernels`); any other view checks the
+    extension, then the connect's steps, with its :func:`steps_free`.
+    """
+    raise TypeError("growth_free is a compiled kernel: call it from numba-compiled code with a checker's view")
 
 
 _TARGETS: dict[int, weakref.ref[Any]] = {}  # handle -> object, held weakly (its entry leaves with it)

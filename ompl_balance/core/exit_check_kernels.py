@@ -1,12 +1,13 @@
 """The compiled kernels of :class:`~ompl_balance.core.exit_checks.ExitChecks`: states and motions
-checked by Python, a tree's growth (a motion, or the steps of a connect) in one exit."""
+checked by Python, a tree's growth (a motion, or the steps of a connect) or an iteration's (the
+extension and the connect) in one exit."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .check_overloads import register_kernels, steps_one_by_one
-from .checks import Count
+from .check_overloads import growth_in_turn, register_kernels, steps_one_by_one
+from .checks import EXTENSION_BLOCKED, Count
 from .compiled_spaces import interpolate, segment_count
 from .discrete_motion_kernels import fraction_between, order_between
 from .exit_checks import ExitChecks, Query
@@ -103,22 +104,54 @@ def exit_motion_free(view: ExitChecks, a: np.ndarray, b: np.ndarray) -> bool:  #
 
 
 @njit_borrowing
+def _queue_steps(
+    view: ExitChecks, chain: np.ndarray, steps: int, outward: bool, first_step: int, filled: int
+) -> tuple[int, int]:  # pragma: no cover (compiled)
+    """Append to ``view.rows[filled:]`` the states the steps ``chain[0] -> ... -> chain[steps]``
+    test, numbered from ``first_step``, as :func:`_queue_motion` appends one (the rows filled, and
+    the blocked step an ask found, ``NO_STEP``: none)."""
+    for k in range(1, steps + 1):
+        if outward:
+            filled, blocked = _queue_motion(view, chain[k - 1], chain[k], first_step + k - 1, False, filled)
+        else:
+            filled, blocked = _queue_motion(view, chain[k], chain[k - 1], first_step + k - 1, True, filled)
+        if blocked != NO_STEP:
+            return filled, blocked
+    return filled, NO_STEP
+
+
+@njit_borrowing
 def exit_steps_free(view: ExitChecks, chain: np.ndarray, steps: int, outward: bool) -> int:  # pragma: no cover
     """:func:`~ompl_balance.core.checks.steps_free`: batched, every state the steps test in one
     exit (in as many as the rows need), in the order and with the counts of checking them one by
     one; otherwise a state and a motion at a time."""
     if not view.batched:
         return steps_one_by_one(view, chain, steps, outward)
-    filled = 0
-    for k in range(1, steps + 1):
-        if outward:
-            filled, blocked = _queue_motion(view, chain[k - 1], chain[k], k, False, filled)
-        else:
-            filled, blocked = _queue_motion(view, chain[k], chain[k - 1], k, True, filled)
-        if blocked != NO_STEP:
-            return blocked - 1
-    blocked = _ask_rows(view, filled)
+    filled, blocked = _queue_steps(view, chain, steps, outward, 1, 0)
+    if blocked == NO_STEP:
+        blocked = _ask_rows(view, filled)
     return steps if blocked == NO_STEP else blocked - 1
 
 
-register_kernels(ExitChecks, state=exit_state_free, motion=exit_motion_free, steps=exit_steps_free)
+@njit_borrowing
+def exit_growth_free(
+    view: ExitChecks, extension: np.ndarray, extension_outward: bool, chain: np.ndarray, steps: int, outward: bool
+) -> int:  # pragma: no cover (compiled)
+    """:func:`~ompl_balance.core.checks.growth_free`: batched, the extension's states and then the
+    connect's in one exit (step 1 the extension, the connect's from 2), so an iteration of a
+    checker written in Python makes one exit where it made two; otherwise in turn."""
+    if not view.batched:
+        return growth_in_turn(view, extension, extension_outward, chain, steps, outward)
+    filled, blocked = _queue_steps(view, extension, 1, extension_outward, 1, 0)
+    if blocked == NO_STEP:
+        filled, blocked = _queue_steps(view, chain, steps, outward, 2, filled)
+    if blocked == NO_STEP:
+        blocked = _ask_rows(view, filled)
+    if blocked == 1:
+        return EXTENSION_BLOCKED
+    return steps if blocked == NO_STEP else blocked - 2
+
+
+register_kernels(
+    ExitChecks, state=exit_state_free, motion=exit_motion_free, steps=exit_steps_free, growth=exit_growth_free
+)

@@ -10,8 +10,9 @@ once, with all the states ``DiscreteMotionValidator::checkMotion`` would test, i
 (:mod:`ompl_balance.core.discrete_motions`); the target tests them in that order until the
 first invalid one, so the answer, and the states tested, are OMPL's. The steps a tree takes
 in one growth (a goal tree's new state and its motion; the steps of a connect) go to Python
-together in the same way (:func:`~ompl_balance.core.checks.steps_free`): one exit where one
-step at a time would make one or two per step. Without ``batched``
+together in the same way (:func:`~ompl_balance.core.checks.steps_free`), and so do an
+iteration's extension and the connect after it (:func:`~ompl_balance.core.checks.growth_free`):
+one exit per iteration where one step at a time would make one or two per step. Without ``batched``
 each query is its own exit (``si.isValid`` or ``si.checkMotion``, for a motion validator of
 the user's own).
 

@@ -61,6 +61,7 @@ class SolveArrays:
             block=np.empty((SAMPLE_BLOCK, dim)),
             uniforms=np.empty((SAMPLE_BLOCK, layout.total_draws)),
             chain=np.empty((2, dim)),
+            extension=np.empty((2, dim)),
             target=np.empty(dim),
             record=np.empty((0, Record.COUNT), dtype=np.int64),
             record_target=np.empty((0, dim)),
@@ -106,7 +107,8 @@ class SolveArrays:
     def start(self, solve: Solve, room: int, record: bool, steps_together: bool) -> None:
         """Ready the arrays for ``solve`` (``room``: the nodes an iteration may add; ``record``:
         whether the loop records what it does; ``steps_together``: whether its checks take a
-        connect's steps together, which the chain then has rows for: at most ``room``).
+        connect's steps together, which the chain then has rows for, at most ``room``, and an
+        iteration's extension with its connect, :data:`~ompl_balance.engine.loop.Slot.CHECKS_AHEAD`).
 
         The loop's state starts at zero, but for the sizes the trees' arrays have room for
         (:meth:`make_room`): they stay true while the planner keeps its trees (their arrays
@@ -114,6 +116,7 @@ class SolveArrays:
         start_tree, goal_tree = solve.start_tree, solve.goal_tree
         assert isinstance(start_tree, ArrayTree) and isinstance(goal_tree, ArrayTree)
         self.loop.ints[: Slot.START_FITS] = 0  # (the sizes with room, the last slots, stay)
+        self.loop.ints[Slot.CHECKS_AHEAD] = steps_together
         self.loop.reals[:] = 0.0
         rows = 4 * room + 64 if record else 0
         if len(self.loop.record) < rows or (rows == 0 and len(self.loop.record)):

@@ -29,7 +29,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from .. import policies
-from ..core.checks import Count, steps_free
+from ..core.checks import EXTENSION_BLOCKED, Count, growth_free, steps_free
 from ..core.compiled_spaces import distance, equal, interpolate, row_distance, samples_from_uniforms, segment_count
 from ..core.kernel_cache import njit, njit_borrowing
 from ..core.layout import SpaceLayout
@@ -84,9 +84,10 @@ class Slot(enum.IntEnum):
     START_COSTS = 16  # nodes whose neighbour-quality cost is known, per tree
     GOAL_COSTS = 17
     RECORDED = 18  # rows of the record in use
-    START_FITS = 19  # per tree, the size up to which every array of the tree has room for one more iteration
-    GOAL_FITS = 20  # (the FITS last: a solve zeroes the slots before them and keeps these)
-    COUNT = 21
+    CHECKS_AHEAD = 19  # 1: the checks take an iteration's extension and connect at once (growth_free)
+    START_FITS = 20  # per tree, the size up to which every array of the tree has room for one more iteration
+    GOAL_FITS = 21  # (the FITS last: a solve zeroes the slots before them and keeps these)
+    COUNT = 22
 
 
 class Real(enum.IntEnum):
@@ -131,7 +132,8 @@ class Loop(NamedTuple):
     ``sizes`` (2,): nodes in the start and goal tree. ``ints`` (:class:`Slot`) and ``reals``
     (:class:`Real`): the loop's state. ``block`` (256, dim) uniform samples, refilled from
     ``uniforms`` (256, draws). ``chain`` (steps + 1, dim): the steps a growth checks together
-    (:func:`_grow`; two rows: one step at a time). ``target`` (dim,): scratch. ``record``
+    (:func:`_grow`; two rows: one step at a time). ``extension`` (2, dim): an extension's step
+    while it is checked with the connect after it (:data:`Slot.CHECKS_AHEAD`). ``target`` (dim,): scratch. ``record``
     (rows, :class:`Record`) and ``record_target`` (rows, dim): what each iteration did.
     """
 
@@ -141,6 +143,7 @@ class Loop(NamedTuple):
     block: np.ndarray
     uniforms: np.ndarray
     chain: np.ndarray
+    extension: np.ndarray
     target: np.ndarray
     record: np.ndarray
     record_target: np.ndarray
@@ -151,6 +154,7 @@ _UNIFORM, _GOAL_BIAS, _GOAL_BALL = int(SamplePolicy.UNIFORM), int(SamplePolicy.G
 _SAMPLE_ATTEMPTS = policies.SAMPLE_ATTEMPTS
 _TRAPPED, _ADVANCED, _REACHED = int(Grow.TRAPPED), int(Grow.ADVANCED), int(Grow.REACHED)
 _CHOICE, _EXTENSION, _CONNECT_STEP = 0, 1, 2  # kinds of row in the loop record
+UNCHECKED = -2  # steps laid out whose checks are still to be made (see _grow's ``checked``)
 
 
 @njit_borrowing
@@ -279,6 +283,36 @@ def _step_taken(
         _copy(target, loop.record_target[row])
 
 
+@njit_borrowing
+def _lay_out(
+    layout: SpaceLayout,
+    settings: LoopSettings,
+    chain: np.ndarray,
+    start: np.ndarray,
+    target: np.ndarray,
+    gap: float,
+    connect: bool,
+) -> tuple[int, bool, bool, float]:  # pragma: no cover (compiled)
+    """Lay out in ``chain`` the steps from ``start`` (``gap`` from ``target``) towards ``target``:
+    ``chain[0]`` the start, ``chain[k]`` where step ``k`` ends; one step, or with ``connect`` as many
+    as the chain holds. Returns the steps, whether the last one reaches ``target``, whether the
+    next one stalls (it rounds back onto its start: trapped, unchecked) and the gap left."""
+    _copy(start, chain[0])
+    steps, reached, stalled = 0, False, False
+    while steps + 1 < chain.shape[0] and not reached and (connect or steps == 0):
+        if gap <= settings.range:
+            _copy(target, chain[steps + 1])
+            reached = True
+        else:
+            interpolate(layout, chain[steps], target, settings.range / gap, chain[steps + 1])
+            if settings.step_may_stall and equal(layout, chain[steps], chain[steps + 1]):
+                stalled = True
+                break
+            gap = distance(layout, chain[steps + 1], target)
+        steps += 1
+    return steps, reached, stalled, gap
+
+
 @njit(cache=True, inline="always")
 def _grow(
     checks: Any,
@@ -292,6 +326,7 @@ def _grow(
     gap: float,
     given: bool,
     connect: bool,
+    checked: int,
 ) -> tuple[int, int]:  # pragma: no cover (compiled)
     """Grow tree ``t`` from ``node`` (``gap`` from ``target``; ``given``: the sample policy chose the
     node) towards ``target``: one step of at most ``range`` (the extension), or with ``connect``
@@ -305,24 +340,16 @@ def _grow(
     (:func:`~ompl_balance.core.checks.steps_free`: one exit to Python for a checker written in
     Python, where one step at a time makes one or two per step), as many as the chain holds at a
     time; the states tested, the nodes added and the record are those of one step at a time.
+    ``checked``: how many of the first steps laid out are free when they were checked already
+    (:func:`_growth_checked`), else :data:`UNCHECKED`.
     """
     tree, chain = trees[t], loop.chain
     while True:
-        # the steps ahead: chain[0] the node grown from, chain[k] where step k ends
-        _copy(tree.states[node], chain[0])
-        steps, reached, stalled = 0, False, False
-        while steps + 1 < chain.shape[0] and not reached and (connect or steps == 0):
-            if gap <= settings.range:
-                _copy(target, chain[steps + 1])
-                reached = True
-            else:
-                interpolate(layout, chain[steps], target, settings.range / gap, chain[steps + 1])
-                if settings.step_may_stall and equal(layout, chain[steps], chain[steps + 1]):
-                    stalled = True  # a step that rounds back onto its start: trapped, unchecked
-                    break
-                gap = distance(layout, chain[steps + 1], target)
-            steps += 1
-        free = steps_free(checks, chain, steps, t == START) if steps > 0 else 0
+        steps, reached, stalled, gap = _lay_out(layout, settings, chain, tree.states[node], target, gap, connect)
+        if checked != UNCHECKED:
+            free, checked = checked, UNCHECKED
+        else:
+            free = steps_free(checks, chain, steps, t == START) if steps > 0 else 0
         for k in range(1, free + 1):
             added = _add_step(layout, settings, tree, loop, t, chain[k - 1], chain[k], node)
             outcome = _REACHED if reached and k == steps else _ADVANCED
@@ -340,6 +367,42 @@ def _grow(
         if not connect:
             return _ADVANCED, node
         # a connect longer than the chain: on from the node added last
+
+
+@njit(cache=True, inline="always")
+def _growth_checked(
+    checks: Any,
+    layout: SpaceLayout,
+    settings: LoopSettings,
+    trees: tuple[Tree, Tree],
+    loop: Loop,
+    t: int,
+    target: np.ndarray,
+    node: int,
+    gap: float,
+) -> tuple[int, int, float, int]:  # pragma: no cover (compiled)
+    """The iteration's extension of tree ``t`` (from ``node``, ``gap`` from ``target``) and the other
+    tree's connect towards its new state, checked in one call
+    (:func:`~ompl_balance.core.checks.growth_free`) before either grows: the connect starts from
+    the other tree's node nearest that state whether or not the extension is free, so its steps
+    are known in advance, and a checker written in Python is asked once an iteration.
+
+    Returns the extension's free steps (1 or 0), the connect's node and gap, and its first
+    chain's free steps, for :func:`_grow` (``checked``); :data:`UNCHECKED` throughout when the
+    extension stalls (``_grow`` finds it trapped without a check)."""
+    extension = loop.extension
+    steps, _reached, stalled, _gap = _lay_out(layout, settings, extension, trees[t].states[node], target, gap, False)
+    if stalled:
+        return UNCHECKED, NO_NODE, 0.0, UNCHECKED
+    o = 1 - t
+    near, near_gap = _node_towards(settings, layout, trees, loop, o, extension[1], NO_NODE)
+    connect_steps, _reached, _stalled, _gap = _lay_out(
+        layout, settings, loop.chain, trees[o].states[near], extension[1], near_gap, True
+    )
+    free = growth_free(checks, extension, t == START, loop.chain, connect_steps, o == START)
+    if free == EXTENSION_BLOCKED:
+        return 0, near, near_gap, UNCHECKED
+    return steps, near, near_gap, free
 
 
 @njit_borrowing
@@ -477,7 +540,14 @@ def run(
             continue
         target = trees[o].states[0] if row == OTHER_ROOT else loop.block[row]
         node, gap = _node_towards(settings, layout, trees, loop, t, target, given)
-        grown, added = _grow(checks, layout, settings, trees, loop, t, target, node, gap, given != NO_NODE, False)
+        checked, near, near_gap, connect_checked = UNCHECKED, NO_NODE, 0.0, UNCHECKED
+        if ints[Slot.CHECKS_AHEAD] != 0:
+            checked, near, near_gap, connect_checked = _growth_checked(
+                checks, layout, settings, trees, loop, t, target, node, gap
+            )
+        grown, added = _grow(
+            checks, layout, settings, trees, loop, t, target, node, gap, given != NO_NODE, False, checked
+        )
         if checks.counts[Count.RAISED] != 0:
             return Stop.RAISED
         if grown == _TRAPPED:
@@ -485,11 +555,15 @@ def run(
         # connect: walk the other tree towards the state just added until trapped or there;
         # each further step extends the node just added (see policies.NearestChoice)
         reach = trees[t].states[added]  # stays put: only the other tree grows while connecting
-        node, gap = _node_towards(settings, layout, trees, loop, o, reach, NO_NODE)
-        connected, reached = _grow(checks, layout, settings, trees, loop, o, reach, node, gap, False, True)
+        if near == NO_NODE:  # (not found with the checks ahead)
+            near, near_gap = _node_towards(settings, layout, trees, loop, o, reach, NO_NODE)
+        connected, reached = _grow(
+            checks, layout, settings, trees, loop, o, reach, near, near_gap, False, True, connect_checked
+        )
         if checks.counts[Count.RAISED] != 0:
             return Stop.RAISED
         # OMPL's "approx goal distance": the other tree's nearest node to the state just added
+        gap = near_gap
         if connected == _REACHED:
             gap = 0.0
         elif settings.nearest_policy != _EUCLIDEAN:
