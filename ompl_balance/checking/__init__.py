@@ -25,7 +25,7 @@ package's planners do with each (:mod:`ompl_balance.checking.functions`):
   once per iteration of the loop (its extension step, then all the steps of the connect after
   it) with all the states OMPL's rule would test;
 * any other Python function of ``q``: called for each state, from one call into Python per
-  iteration.
+  growth of a tree (an extension step; all the steps of a connect).
 
 Stock planners call the same checker and validator (one call into Python per state, or per
 motion for the validator). ``docs/checkers.md`` measures each kind.

@@ -16,7 +16,7 @@ returns a :class:`CheckFunction`, one of four kinds (:data:`KINDS`):
     OMPL's discrete rule would test;
 ``python``
     any other callable ``fn(q) -> bool`` of a 1-D float64 array: called once per state, from
-    one call into Python per iteration.
+    one call into Python per growth of a tree (an extension step; all the steps of a connect).
 
 ``q`` holds the state's values in the flat layout of :mod:`ompl_balance.core.layout` (OMPL's
 ``copyFromReals`` order). A function's error reaches the caller as a :class:`CheckerError`

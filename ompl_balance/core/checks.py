@@ -23,8 +23,9 @@ that calls ``answer(kind, count)`` of the Python object registered under the int
 the view carries (:func:`exit_handle`). The kernel first writes what the query is about into
 arrays the object owns (an :class:`ExitTarget`'s staging arrays, also fields of the view), so
 the exit carries integers only. FCL on a non-convex pair goes out this way, and a checker
-written in Python is called this way once per iteration of the loop (its extension step and
-the connect after it) rather than once per state. Nothing of an exit is compiled when it is
+written in Python is called this way once per growth of a tree (an extension step, or all the
+steps of a connect; a vectorized function once per iteration, both together) rather than once
+per state. Nothing of an exit is compiled when it is
 first taken: it costs the same in every process.
 
 A check that raises (a user's function, FCL, a Ctrl-C in an exit) cannot raise through compiled

@@ -138,8 +138,8 @@ def exit_growth_free(
     view: ExitChecks, extension: np.ndarray, extension_outward: bool, chain: np.ndarray, steps: int, outward: bool
 ) -> int:  # pragma: no cover (compiled)
     """:func:`~ompl_balance.core.checks.growth_free`: batched, the extension's states and then the
-    connect's in one exit (step 1 the extension, the connect's from 2), so an iteration of a
-    checker written in Python makes one exit where it made two; otherwise in turn."""
+    connect's in one exit (step 1 the extension, the connect's from 2), so an iteration makes one
+    exit where it made two; otherwise in turn."""
     if not view.batched:
         return growth_in_turn(view, extension, extension_outward, chain, steps, outward)
     filled, blocked = _queue_steps(view, extension, 1, extension_outward, 1, 0)

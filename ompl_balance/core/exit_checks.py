@@ -10,9 +10,9 @@ once, with all the states ``DiscreteMotionValidator::checkMotion`` would test, i
 (:mod:`ompl_balance.core.discrete_motions`); the target tests them in that order until the
 first invalid one, so the answer, and the states tested, are OMPL's. The steps a tree takes
 in one growth (a goal tree's new state and its motion; the steps of a connect) go to Python
-together in the same way (:func:`~ompl_balance.core.checks.steps_free`), and so do an
-iteration's extension and the connect after it (:func:`~ompl_balance.core.checks.growth_free`):
-one exit per iteration where one step at a time would make one or two per step. Without ``batched``
+together in the same way (:func:`~ompl_balance.core.checks.steps_free`): one exit where one
+step at a time would make one or two per step; with ``per_iteration``, an iteration's extension
+and the connect after it in one exit (:func:`~ompl_balance.core.checks.growth_free`). Without ``batched``
 each query is its own exit (``si.isValid`` or ``si.checkMotion``, for a motion validator of
 the user's own).
 
@@ -86,6 +86,10 @@ class ExitChecks(NamedTuple):
     motion tests (the others: the states between, and a goal tree's new state, tested before its
     motion); ``queue`` (longest, 2) and ``order`` (longest,) are the
     bisection's scratch; ``counts`` the work counter (batched: states and motions; always: exits).
+    ``per_iteration`` (batched only): an iteration's extension and the connect after it go to the
+    target in one exit (:func:`~ompl_balance.core.checks.growth_free`), the connect's states laid
+    out before the extension is known to be free; for a target whose call costs far more than
+    laying them out in vain (a vectorized numpy function: tens of microseconds a call).
     """
 
     address: int
@@ -97,6 +101,7 @@ class ExitChecks(NamedTuple):
     order: np.ndarray
     counts: np.ndarray
     batched: bool
+    per_iteration: bool
 
 
 #: Rows of a batched view per state of the space's longest motion: room for a connect across the
@@ -104,12 +109,25 @@ class ExitChecks(NamedTuple):
 ROWS_PER_LONGEST = 2
 
 
-def exit_checks(target: Any, layout: SpaceLayout, extent: float, counts: np.ndarray, batched: bool) -> ExitChecks:
+def exit_checks(
+    target: Any, layout: SpaceLayout, extent: float, counts: np.ndarray, batched: bool, per_iteration: bool = False
+) -> ExitChecks:
     """The :class:`ExitChecks` of ``target`` (an object with ``answer`` and ``error``) in a space of
     ``layout`` and maximum extent ``extent``, counting in ``counts``; rows for the states of
     :data:`ROWS_PER_LONGEST` longest motions when ``batched`` (more go to Python in parts),
-    else for two states."""
+    else for two states; ``per_iteration``: see :class:`ExitChecks`."""
     queue, order = bisection_scratch(extent, layout)
     rows = np.empty((ROWS_PER_LONGEST * len(order) if batched else 2, layout.dim))
     row_steps = np.empty(len(rows), dtype=np.int64)
-    return ExitChecks(EXIT_ADDRESS, exit_handle(target), layout, rows, row_steps, queue, order, counts, batched)
+    return ExitChecks(
+        EXIT_ADDRESS,
+        exit_handle(target),
+        layout,
+        rows,
+        row_steps,
+        queue,
+        order,
+        counts,
+        batched,
+        batched and per_iteration,
+    )

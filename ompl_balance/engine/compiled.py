@@ -111,7 +111,7 @@ def _driver() -> ModuleType:
 def runs_compiled(checks: EngineChecks, engine: str) -> bool:
     """Whether ``engine`` (``"auto"`` or ``"compiled"``) plans on the compiled engine with ``checks``:
     both do, whatever the checks (see ``docs/engine.md``: with a checker written in Python the
-    compiled loop and its one call into Python per iteration cost less than the Python engine's
+    compiled loop and its one call into Python per growth of a tree cost less than the Python engine's
     loop around the same checks)."""
     return engine in ("auto", "compiled")
 

@@ -104,11 +104,12 @@ class SolveArrays:
             self.room, self._fitted = room, False
         self.make_room()
 
-    def start(self, solve: Solve, room: int, record: bool, steps_together: bool) -> None:
+    def start(self, solve: Solve, room: int, record: bool, steps_together: bool, per_iteration: bool) -> None:
         """Ready the arrays for ``solve`` (``room``: the nodes an iteration may add; ``record``:
         whether the loop records what it does; ``steps_together``: whether its checks take a
-        connect's steps together, which the chain then has rows for, at most ``room``, and an
-        iteration's extension with its connect, :data:`~ompl_balance.engine.loop.Slot.CHECKS_AHEAD`).
+        connect's steps together, which the chain then has rows for: at most ``room``;
+        ``per_iteration``: whether they take an iteration's extension and connect together,
+        :data:`~ompl_balance.engine.loop.Slot.CHECKS_AHEAD`).
 
         The loop's state starts at zero, but for the sizes the trees' arrays have room for
         (:meth:`make_room`): they stay true while the planner keeps its trees (their arrays
@@ -116,7 +117,7 @@ class SolveArrays:
         start_tree, goal_tree = solve.start_tree, solve.goal_tree
         assert isinstance(start_tree, ArrayTree) and isinstance(goal_tree, ArrayTree)
         self.loop.ints[: Slot.START_FITS] = 0  # (the sizes with room, the last slots, stay)
-        self.loop.ints[Slot.CHECKS_AHEAD] = steps_together
+        self.loop.ints[Slot.CHECKS_AHEAD] = per_iteration
         self.loop.reals[:] = 0.0
         rows = 4 * room + 64 if record else 0
         if len(self.loop.record) < rows or (rows == 0 and len(self.loop.record)):
@@ -286,7 +287,7 @@ def run(
     in ``arrays`` (``key``: the :func:`~ompl_balance.engine.loading.view_key` of ``checks.view``
     and the layout; ``room``: the nodes an iteration may add)."""
     settings = arrays.settings_for(solve.points, solve.settings, solve.record is not None)
-    arrays.start(solve, room, settings.record, checks.steps_together)
+    arrays.start(solve, room, settings.record, checks.steps_together, checks.per_iteration)
     layout, ints, reals = arrays.layout, arrays.loop.ints, arrays.loop.reals
     state = solve.swap_state
     ints[Slot.GREW_START], ints[Slot.STEPS], ints[Slot.COLLIDED] = state.grew_start, state.steps, state.collided

@@ -385,7 +385,8 @@ def _growth_checked(
     tree's connect towards its new state, checked in one call
     (:func:`~ompl_balance.core.checks.growth_free`) before either grows: the connect starts from
     the other tree's node nearest that state whether or not the extension is free, so its steps
-    are known in advance, and a checker written in Python is asked once an iteration.
+    are known in advance, and a checker whose calls are costly (a vectorized function) is asked
+    once an iteration (:data:`Slot.CHECKS_AHEAD`).
 
     Returns the extension's free steps (1 or 0), the connect's node and gap, and its first
     chain's free steps, for :func:`_grow` (``checked``); :data:`UNCHECKED` throughout when the

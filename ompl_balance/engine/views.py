@@ -90,7 +90,8 @@ class EngineChecks:
     ``reporter``: the object that raises an error a check kept (its ``raise_error()``), if any.
     ``steps_together``: whether its kernels check a tree's steps in one call to Python (a
     batched :class:`~ompl_balance.core.exit_checks.ExitChecks`), so the loop lays a whole
-    connect out for them at once.
+    connect out for them at once; ``per_iteration``: whether they check an iteration's extension
+    and connect in one call (the view's ``per_iteration``).
     """
 
     def __init__(self, view: Any, path: str, source: tuple[Any, ...], reporter: Any = None) -> None:
@@ -98,6 +99,7 @@ class EngineChecks:
         self.path = path
         self.exits = exits_to_python(view)
         self.steps_together = isinstance(view, ExitChecks) and view.batched
+        self.per_iteration = self.steps_together and view.per_iteration
         self.source = source
         self.reporter = reporter  # also keeps an exit's target alive (the registry holds it weakly)
 
