@@ -241,6 +241,42 @@ class RowsTarget:
         return count
 
 
+def steps_one_by_one(reference, chain, steps, outward):
+    """The oracle of a tree's steps: OMPL's own ``isValid`` and ``DiscreteMotionValidator`` called
+    one step at a time as RRT-Connect grows a tree (outward: the start tree; else the goal tree,
+    the new state first). Returns the steps free and the motions begun."""
+    a, b = reference.allocState(), reference.allocState()
+    for k in range(1, steps + 1):
+        a[0], a[1] = chain[k - 1] if outward else chain[k]
+        b[0], b[1] = chain[k] if outward else chain[k - 1]
+        if not outward and not reference.isValid(a):
+            return k - 1, k - 1
+        if not reference.checkMotion(a, b):
+            return k - 1, k
+    return steps, steps
+
+
+def batched_exit_view(reference, rows):
+    """A batched exit view of :func:`state_free` (``rows``: its rows, else the view's own) and its target."""
+    from ompl_balance.core.checks import Count, load_kernels
+    from ompl_balance.core.exit_checks import exit_checks
+    from ompl_balance.core.layout import layout_for
+
+    layout = layout_for(reference.getStateSpace())
+    target = RowsTarget()
+    view = exit_checks(target, layout, reference.getMaximumExtent(), np.zeros(len(Count), dtype=np.int64), True)
+    if rows is not None:
+        view = view._replace(rows=np.empty((rows, 2)), row_steps=np.empty(rows, dtype=np.int64))
+    target.rows = view.rows
+    load_kernels(view)
+    return view, target
+
+
+def random_chain(rng, steps):
+    """``steps`` short random steps in the unit square, (steps + 1, 2)."""
+    return np.cumsum(np.vstack([rng.random(2), 0.15 * (rng.random((steps, 2)) - 0.5)]), axis=0).clip(0.0, 1.0)
+
+
 @pytest.mark.parametrize("rows", [3, 40, None])
 @pytest.mark.parametrize("outward", [True, False])
 def test_a_trees_steps_checked_together_are_checked_as_one_by_one(rows, outward):
@@ -249,41 +285,22 @@ def test_a_trees_steps_checked_together_are_checked_as_one_by_one(rows, outward)
     the steps taken, the states tested and the motions begun are those of OMPL's own
     ``isValid`` and ``DiscreteMotionValidator`` called one step at a time as RRT-Connect grows a
     tree (outward: the start tree; else the goal tree, the new state first)."""
-    from ompl_balance.core.checks import Count, load_kernels, steps_free
-    from ompl_balance.core.exit_checks import exit_checks
-    from ompl_balance.core.layout import layout_for
+    from ompl_balance.core.checks import Count, steps_free
 
     reference, calls = ompl_reference(state_free)
-    layout = layout_for(reference.getStateSpace())
-    target = RowsTarget()
-    view = exit_checks(target, layout, reference.getMaximumExtent(), np.zeros(len(Count), dtype=np.int64), True)
-    if rows is not None:
-        view = view._replace(rows=np.empty((rows, 2)), row_steps=np.empty(rows, dtype=np.int64))
-    target.rows = view.rows
-    load_kernels(view)
+    view, _target = batched_exit_view(reference, rows)
 
     @numba.njit
     def call(view, chain, steps, outward):  # (steps_free from compiled code, as the loop calls it)
         return steps_free(view, chain, steps, outward)
 
     rng = np.random.default_rng(11)
-    a, b = reference.allocState(), reference.allocState()
     taken = []
     for _ in range(200):
         steps = int(rng.integers(1, 6))
-        chain = np.cumsum(np.vstack([rng.random(2), 0.15 * (rng.random((steps, 2)) - 0.5)]), axis=0).clip(0.0, 1.0)
+        chain = random_chain(rng, steps)
         before_calls, before = calls[0], view.counts.copy()
-        free, motions = steps, 0
-        for k in range(1, steps + 1):  # the oracle: one step at a time
-            a[0], a[1] = chain[k - 1] if outward else chain[k]
-            b[0], b[1] = chain[k] if outward else chain[k - 1]
-            if not outward and not reference.isValid(a):
-                free = k - 1
-                break
-            motions += 1
-            if not reference.checkMotion(a, b):
-                free = k - 1
-                break
+        free, motions = steps_one_by_one(reference, chain, steps, outward)
         assert call(view, chain, steps, outward) == free
         assert view.counts[Count.STATES] - before[Count.STATES] == calls[0] - before_calls
         assert view.counts[Count.MOTIONS] - before[Count.MOTIONS] == motions
@@ -291,6 +308,45 @@ def test_a_trees_steps_checked_together_are_checked_as_one_by_one(rows, outward)
     assert any(free == 0 for free in taken) and any(free > 1 for free in taken)
     exits_per_chain = view.counts[Count.EXITS] / len(taken)
     assert exits_per_chain > 1 if rows == 3 else exits_per_chain == 1
+
+
+@pytest.mark.parametrize("rows", [3, 40, None])
+@pytest.mark.parametrize("extension_outward", [True, False])
+def test_an_iterations_extension_and_connect_checked_together_are_checked_as_one_by_one(rows, extension_outward):
+    """``growth_free`` of a batched exit view (a vectorized function's: an iteration's extension
+    step, then the other tree's connect, in one call to Python, in parts when its rows are full):
+    on 200 random extensions and connects, the answer (the connect's free steps, or
+    ``EXTENSION_BLOCKED``), the states tested and the motions begun are those of OMPL's own
+    checks one step at a time: the extension, then the connect's steps only if it is free."""
+    from ompl_balance.core.checks import EXTENSION_BLOCKED, Count, growth_free
+
+    reference, calls = ompl_reference(state_free)
+    view, _target = batched_exit_view(reference, rows)
+
+    @numba.njit
+    def call(view, extension, extension_outward, chain, steps, outward):  # (as the loop calls it)
+        return growth_free(view, extension, extension_outward, chain, steps, outward)
+
+    rng = np.random.default_rng(12)
+    answers = []
+    outward = not extension_outward  # (the connect grows the other tree)
+    for _ in range(200):
+        extension, steps = random_chain(rng, 1), int(rng.integers(1, 6))
+        chain = random_chain(rng, steps)
+        before_calls, before = calls[0], view.counts.copy()
+        free, motions = steps_one_by_one(reference, extension, 1, extension_outward)
+        if free == 0:
+            expected = EXTENSION_BLOCKED
+        else:
+            expected, connect_motions = steps_one_by_one(reference, chain, steps, outward)
+            motions += connect_motions
+        assert call(view, extension, extension_outward, chain, steps, outward) == expected
+        assert view.counts[Count.STATES] - before[Count.STATES] == calls[0] - before_calls
+        assert view.counts[Count.MOTIONS] - before[Count.MOTIONS] == motions
+        answers.append(expected)
+    assert EXTENSION_BLOCKED in answers and 0 in answers and any(answer > 1 for answer in answers)
+    exits_per_iteration = view.counts[Count.EXITS] / len(answers)
+    assert exits_per_iteration > 1 if rows == 3 else exits_per_iteration == 1
 
 
 @pytest.mark.parametrize("kind", list(KINDS))

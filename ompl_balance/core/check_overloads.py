@@ -15,7 +15,7 @@ from numba.extending import type_callable
 from .checks import EXTENSION_BLOCKED, growth_free, motion_free, state_free, steps_free
 from .kernel_cache import njit_borrowing
 
-#: ``(state_free, motion_free or steps_free; a view class)`` -> the view's compiled kernel for it
+#: ``(state_free, motion_free, steps_free or growth_free; a view class)`` -> the view's compiled kernel for it
 _KERNELS: dict[tuple[Any, type | None], Any] = {}
 
 
