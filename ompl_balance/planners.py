@@ -243,8 +243,13 @@ class BalancedRRTConnect(TreePlanner):
 
     def clear(self) -> None:
         super().clear()
-        self._start_tree = self._goal_tree = None
-        self._failures = {}
+        # The trees are emptied, not made anew (as OMPL's planners clear their nearest-neighbour
+        # structures): their arrays, and the compiled engine's for them, serve the next solve.
+        for tree in (self._start_tree, self._goal_tree):
+            if tree is not None:
+                tree.clear()
+        for failures in self._failures.values():
+            failures.clear()
         self._swap_state = SwapState()
         self._connection = None
         self._distance_between_trees = math.inf

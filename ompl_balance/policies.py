@@ -281,6 +281,10 @@ class NodeFailures:
             grown[: len(self.array)] = self.array
             self.array = grown
 
+    def clear(self) -> None:
+        """No failures (the tree was emptied); the array stays, as compiled code may hold it."""
+        self.array[:] = 0
+
     def record(self, node: int) -> None:
         self.reserve(node + 1)
         self.array[node] += 1

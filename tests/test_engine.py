@@ -26,6 +26,7 @@ from ompl_time import timed
 from ompl_balance import BalancedRRTConnect
 from ompl_balance.core.counting import CountingValidityChecker
 from ompl_balance.core.layout import layout_for
+from ompl_balance.engine.index import INDEX_FROM
 from ompl_balance.planners import PRESETS
 from ompl_balance.worlds.boxes import BoxWorld2D, get_problem
 from ompl_balance.worlds.occupancy import rooms_problem
@@ -123,6 +124,23 @@ def test_intermediate_states_and_repeated_solves_without_clear():
     compiled = solve(make, "compiled", solves=3, **kwargs)
     assert_same_run(python, compiled)
     assert python[2][1]["start_tree_size"] > python[0][1]["start_tree_size"]  # the trees carry over
+
+
+def test_a_cleared_planner_solves_as_a_new_one():
+    """clear() empties the trees in place (their arrays, the compiled engine's index and the nodes'
+    failure counts kept for the next solve): the solve after it makes the trees, path and counts
+    of a new planner with the same seed, on both engines, after trees searched through the index."""
+    make = get_problem("bug_trap").setup
+    params = {"nearest_policy": "exhausted", "exhausted_after": "2", "range": "0.02"}  # (failures matter)
+
+    def cleared_and_reseeded(ss, planner):
+        ss.clear()
+        planner.params().setParam("seed", "11")
+
+    for engine in ("python", "compiled"):
+        first, cleared = solve(make, engine, seed=3, params=params, solves=2, between=(cleared_and_reseeded,))
+        assert max(len(tree) for tree in first[2]) >= INDEX_FROM  # (the index was built)
+        assert_same_run([cleared], solve(make, engine, seed=11, params=params))
 
 
 def finer_resolution(ss, planner):

@@ -29,7 +29,7 @@ from ..core.trees import ArrayTree
 from ..policies import SwapCause
 from . import loop
 from .events import Grow, GrowStep, TreeChoiceEvent
-from .index import INDEX_FROM, KDIndex, Setting, grown, new_index
+from .index import INDEX_FROM, KDIndex, Setting, grown, new_index, truncate
 from .loop import Real, Record, Slot, Stop
 from .settings import RRTConnectSettings, loop_settings
 from .solve import Solve
@@ -89,10 +89,13 @@ class SolveArrays:
         """Keep arrays for the planner's trees ``start_tree``, ``goal_tree`` (with their
         :class:`~ompl_balance.policies.NodeFailures` ``failures``) with room for an iteration that
         adds ``room`` nodes: their index and cost arrays (new ones, sized for the trees'
-        capacity, unless these are the trees held already) and the loop's view of them
-        (:attr:`trees`)."""
+        capacity, unless these are the trees held already, their indexes then cut back to the
+        trees' sizes) and the loop's view of them (:attr:`trees`)."""
         held = self._planner_trees
-        if not (len(held) == 2 and held[0] is start_tree and held[1] is goal_tree):
+        if len(held) == 2 and held[0] is start_tree and held[1] is goal_tree:
+            for index, tree in zip(self.indexes, held):
+                truncate(index, len(tree))  # (a tree the planner's clear() emptied)
+        else:
             self._planner_trees = (start_tree, goal_tree)
             capacities = [len(tree.storage().parents) for tree in self._planner_trees]
             self.indexes = [new_index(self.layout, 0) for _ in capacities]  # (grown once a tree needs it)

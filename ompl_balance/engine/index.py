@@ -150,6 +150,13 @@ def new_index(layout: SpaceLayout, capacity: int) -> KDIndex:
     )
 
 
+def truncate(index: KDIndex, size: int) -> None:
+    """Forget the built nodes from ``size`` on, for a tree cut back to ``size`` nodes (a planner's
+    ``clear()`` empties its trees): the next query builds its blocks again."""
+    if index.ints[Setting.BUILT] > size:
+        index.ints[Setting.BUILT] = 0
+
+
 def grown(index: KDIndex, capacity: int) -> KDIndex:
     """``index`` with room for ``capacity`` nodes (itself when it has that room, or when it has no
     axes: then the tree is scanned and the index's node arrays are never used)."""
