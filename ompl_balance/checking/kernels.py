@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.array_kernels import copy_into
 from ..core.check_overloads import register_kernels
 from ..core.checks import Count
 from ..core.function_pointers import call_state_function
@@ -19,15 +20,13 @@ def function_state_free(view: FunctionStates, q: np.ndarray) -> bool:  # pragma:
     :func:`~ompl_balance.worlds.box_kernels.box_state_free`.)"""
     address, given, failed, counts = view.address, view.given, view.failed, view.counts
     counts[Count.STATES] += 1
-    for i in range(q.shape[0]):
-        given[i] = q[i]
+    copy_into(q, given)
     answer = call_state_function(address, given)
     if answer == 1:
         return True
     if answer < 0:
         counts[Count.RAISED] = 1
-        for i in range(q.shape[0]):
-            failed[i] = q[i]
+        copy_into(q, failed)
     return False
 
 

@@ -37,6 +37,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..core.array_kernels import copy_into
 from ..core.kernel_cache import njit, njit_borrowing
 from .convex import ConvexParts, Vector, distance_bounds
 from .kinematics import Chain, chain_poses
@@ -340,8 +341,7 @@ def memory_row(memory: EndMemory, q: np.ndarray) -> int:  # pragma: no cover (co
                 return row
     row = memory.next[0]
     memory.next[0] = (row + 1) % keys.shape[0]
-    for j in range(q.shape[0]):
-        keys[row, j] = q[j]
+    copy_into(q, keys[row])
     memory.used[row] = True
     memory.generation[row] += 1
     bounds = memory.bounds

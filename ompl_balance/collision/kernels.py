@@ -33,6 +33,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from ..core.array_kernels import copy_into
 from ..core.check_overloads import register_kernels
 from ..core.checks import EXIT_ADDRESS, Count, exit_handle
 from ..core.compiled_spaces import segment_count
@@ -252,7 +253,7 @@ def _stage_screened(
     view: RobotStates, poses: np.ndarray, obstacle_hits: np.ndarray, self_hits: np.ndarray, k: int
 ) -> None:  # pragma: no cover (compiled)
     """Row ``k`` of a batch's screening arrays into the view's one-row arrays, which the checker's
-    exit reads (element by element: see :func:`segments_exit`)."""
+    exit reads (element by element: see :func:`~ompl_balance.core.array_kernels.copy_into`)."""
     for body in range(poses.shape[1]):
         for i in range(4):
             for j in range(4):
@@ -260,8 +261,7 @@ def _stage_screened(
     for o in range(obstacle_hits.shape[1]):
         for g in range(obstacle_hits.shape[2]):
             view.obstacle_hits[0, o, g] = obstacle_hits[k, o, g]
-    for pair in range(self_hits.shape[1]):
-        view.self_hits[0, pair] = self_hits[k, pair]
+    copy_into(self_hits[k], view.self_hits[0])
 
 
 class SegmentExits(NamedTuple):
@@ -439,11 +439,9 @@ def segments_exit(
     b``, with the end-memory rows ``start``, ``end`` and ``left`` work units: its answer, -1 when it
     raised. The segments are staged ``len(exits.pairs)`` at a time, the parts before the last
     kept by the certifier (``STAGE_SEGMENTS``); ``exits.numbers[Staged.WORK_SPENT]`` holds the work
-    units the query spent. (Arrays are copied element by element: an array assigned to a slice
-    has numba compile its shape-mismatch error, seconds of compiling.)"""
-    for j in range(a.shape[0]):
-        exits.ends[0, j] = a[j]
-        exits.ends[1, j] = b[j]
+    units the query spent."""
+    copy_into(a, exits.ends[0])
+    copy_into(b, exits.ends[1])
     numbers, total = exits.numbers, pairs.shape[0]
     numbers[Staged.START_ROW], numbers[Staged.END_ROW], numbers[Staged.WORK_LEFT] = start, end, left
     numbers[Staged.SEGMENTS], numbers[Staged.WORK_SPENT] = total, 0

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .array_kernels import copy_into
 from .check_overloads import growth_in_turn, register_kernels, steps_one_by_one
 from .checks import EXTENSION_BLOCKED, Count
 from .compiled_spaces import interpolate, segment_count
@@ -65,9 +66,7 @@ def _queue_motion(
             filled = 0
         row = rows[filled]
         if k < 1:
-            source = a if k < 0 else b
-            for i in range(source.shape[0]):
-                row[i] = source[i]
+            copy_into(a if k < 0 else b, row)
         else:
             interpolate(layout, a, b, fraction_between(k - 1, n, in_order, order), row)
         tags[filled] = 2 * step + (1 if k == 0 else 0)
@@ -78,9 +77,7 @@ def _queue_motion(
 @njit_borrowing
 def exit_state_free(view: ExitChecks, q: np.ndarray) -> bool:  # pragma: no cover (compiled)
     """Whether ``q`` is valid: one exit (a state counted here where the view is batched)."""
-    rows = view.rows
-    for i in range(q.shape[0]):
-        rows[0, i] = q[i]
+    copy_into(q, view.rows[0])
     if view.batched:
         view.counts[Count.STATES] += 1
     return _ask(view, _STATES, 1) == 1
@@ -95,9 +92,8 @@ def exit_motion_free(view: ExitChecks, a: np.ndarray, b: np.ndarray) -> bool:  #
     the motion.
     """
     if not view.batched:
-        rows = view.rows
-        for i in range(a.shape[0]):
-            rows[0, i], rows[1, i] = a[i], b[i]
+        copy_into(a, view.rows[0])
+        copy_into(b, view.rows[1])
         return _ask(view, _MOTION, 2) == 1
     filled, blocked = _queue_motion(view, a, b, 1, False, 0)
     return blocked == NO_STEP and _ask_rows(view, filled) == NO_STEP

@@ -29,6 +29,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from .. import policies
+from ..core.array_kernels import copy_into
 from ..core.checks import EXTENSION_BLOCKED, Count, growth_free, steps_free
 from ..core.compiled_spaces import distance, equal, interpolate, row_distance, samples_from_uniforms, segment_count
 from ..core.kernel_cache import njit, njit_borrowing
@@ -192,15 +193,8 @@ def _find_nearest(
 
 
 @njit_borrowing
-def _copy(source: np.ndarray, destination: np.ndarray) -> None:  # pragma: no cover (compiled)
-    """``destination[:] = source`` as a loop (an array assignment compiles its shape checks' messages)."""
-    for k in range(source.shape[0]):
-        destination[k] = source[k]
-
-
-@njit_borrowing
 def _add(tree: Tree, size: int, state: np.ndarray, parent: int) -> None:  # pragma: no cover (compiled)
-    _copy(state, tree.states[size])
+    copy_into(state, tree.states[size])
     tree.parents[size] = parent
     tree.roots[size] = size if parent == NO_NODE else tree.roots[parent]
     tree.failures[size] = 0
@@ -280,7 +274,7 @@ def _step_taken(
     if settings.record:
         kind = _CONNECT_STEP if connect else _EXTENSION
         row = _note(loop, loop.ints[Slot.ITERATIONS], kind, 1 - t, node, int(given), outcome, added)
-        _copy(target, loop.record_target[row])
+        copy_into(target, loop.record_target[row])
 
 
 @njit_borrowing
@@ -297,11 +291,11 @@ def _lay_out(
     ``chain[0]`` the start, ``chain[k]`` where step ``k`` ends; one step, or with ``connect`` as many
     as the chain holds. Returns the steps, whether the last one reaches ``target``, whether the
     next one stalls (it rounds back onto its start: trapped, unchecked) and the gap left."""
-    _copy(start, chain[0])
+    copy_into(start, chain[0])
     steps, reached, stalled = 0, False, False
     while steps + 1 < chain.shape[0] and not reached and (connect or steps == 0):
         if gap <= settings.range:
-            _copy(target, chain[steps + 1])
+            copy_into(target, chain[steps + 1])
             reached = True
         else:
             interpolate(layout, chain[steps], target, settings.range / gap, chain[steps + 1])

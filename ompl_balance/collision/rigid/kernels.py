@@ -18,6 +18,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from ...core.array_kernels import copy_into
 from ...core.check_overloads import register_kernels
 from ...core.checks import EXIT_ADDRESS, Count, exit_handle, kernels_in
 from ...core.function_pointers import call_exit
@@ -79,9 +80,8 @@ def decide(view: RigidStates, kind: int, a: np.ndarray, b: np.ndarray) -> bool: 
     (``Exit.DECIDE_STATE``; ``b`` unused) or of the motion ``a -> b`` (``Exit.DECIDE_MOTION``);
     counts the exit. ``False`` with ``counts[Count.RAISED]`` set when the checker raised."""
     view.counts[Count.EXITS] += 1
-    for j in range(a.shape[0]):  # (element by element: see collision.kernels.segments_exit)
-        view.staged[0, j] = a[j]
-        view.staged[1, j] = b[j]
+    copy_into(a, view.staged[0])
+    copy_into(b, view.staged[1])
     answer = call_exit(view.address, view.handle, kind, 0)
     if answer < 0:
         view.counts[Count.RAISED] = 1
