@@ -151,8 +151,9 @@ def new_index(layout: SpaceLayout, capacity: int) -> KDIndex:
 
 
 def truncate(index: KDIndex, size: int) -> None:
-    """Forget the built nodes from ``size`` on, for a tree cut back to ``size`` nodes (a planner's
-    ``clear()`` empties its trees): the next query builds its blocks again."""
+    """``index`` for its tree cut back to ``size`` nodes (a planner's ``clear()`` empties its
+    trees): where nodes it built are gone it forgets all it built, and the next query builds its
+    blocks again."""
     if index.ints[Setting.BUILT] > size:
         index.ints[Setting.BUILT] = 0
 
