@@ -37,7 +37,7 @@ from ..core.array_kernels import copy_into
 from ..core.check_overloads import register_kernels
 from ..core.checks import EXIT_ADDRESS, Count, exit_handle
 from ..core.compiled_spaces import segment_count
-from ..core.function_pointers import call_exit
+from ..core.function_pointers import call_exit, counted_exit
 from ..core.kernel_cache import njit
 from ..core.layout import SpaceLayout
 from .advancement import EdgeModel, EdgeScratch, EndMemory, advance, memory_row
@@ -127,12 +127,7 @@ def within_limits(view: RobotStates, q: np.ndarray) -> bool:  # pragma: no cover
 def decide_screened(view: RobotStates) -> bool:  # pragma: no cover (compiled)
     """FCL on what the screening of one configuration left, in the view's one-row arrays (one
     exit to the checker); ``False`` with ``counts[Count.RAISED]`` set when the checker raised."""
-    view.counts[Count.EXITS] += 1
-    answer = call_exit(view.address, view.handle, _DECIDE, 0)
-    if answer < 0:
-        view.counts[Count.RAISED] = 1
-        return False
-    return answer == 1
+    return counted_exit(view.counts, view.address, view.handle, _DECIDE, 0) == 1
 
 
 @njit(cache=True)

@@ -12,7 +12,7 @@ from .checks import EXTENSION_BLOCKED, Count
 from .compiled_spaces import interpolate, segment_count
 from .discrete_motion_kernels import fraction_between, order_between
 from .exit_checks import ExitChecks, Query
-from .function_pointers import call_exit
+from .function_pointers import counted_exit
 from .kernel_cache import njit_borrowing
 
 _STATES, _MOTION = int(Query.STATES), int(Query.MOTION)
@@ -23,11 +23,7 @@ NO_STEP = 0  # what _ask_rows answers when every state asked about is valid (ste
 def _ask(view: ExitChecks, kind: int, count: int) -> int:  # pragma: no cover (compiled)
     """One exit to the view's target about ``view.rows[:count]`` (counted); -1, with the view's
     RAISED flag set, when it raised."""
-    view.counts[Count.EXITS] += 1
-    answer = call_exit(view.address, view.handle, kind, count)
-    if answer < 0:
-        view.counts[Count.RAISED] = 1
-    return answer
+    return counted_exit(view.counts, view.address, view.handle, kind, count)
 
 
 @njit_borrowing

@@ -31,6 +31,9 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from .checks import Count
+from .kernel_cache import njit_borrowing
+
 
 def _state_function_typing(typingctx: Any, address: Any, q: Any) -> Any:
     """``check(q.ctypes.data, q.size)`` for the state function at ``address`` (an integer), ``q`` a
@@ -70,3 +73,15 @@ def _exit_typing(typingctx: Any, address: Any, handle: Any, kind: Any, count: An
 call_state_function = cast(Callable[[int, Any], int], intrinsic(_state_function_typing))
 #: ``call_exit(address, handle, kind, count) -> int64`` (compiled code only; see :func:`_exit_typing`).
 call_exit = cast(Callable[[int, int, int, int], int], intrinsic(_exit_typing))
+
+
+@njit_borrowing
+def counted_exit(counts: Any, address: int, handle: int, kind: int, count: int) -> int:  # pragma: no cover (compiled)
+    """:func:`call_exit`, counted in ``counts[Count.EXITS]`` (a view's counts, indexed by
+    :class:`~ompl_balance.core.checks.Count`): the exit's answer, -1 with ``counts[Count.RAISED]``
+    set when the target raised."""
+    counts[Count.EXITS] += 1
+    answer = call_exit(address, handle, kind, count)
+    if answer < 0:
+        counts[Count.RAISED] = 1
+    return answer

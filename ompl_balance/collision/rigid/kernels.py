@@ -21,7 +21,7 @@ import numpy as np
 from ...core.array_kernels import copy_into
 from ...core.check_overloads import register_kernels
 from ...core.checks import EXIT_ADDRESS, Count, exit_handle, kernels_in
-from ...core.function_pointers import call_exit
+from ...core.function_pointers import counted_exit
 from ...core.kernel_cache import njit
 from .advance import edge_status
 from .motion import interpolate, motion_split
@@ -79,14 +79,9 @@ def decide(view: RigidStates, kind: int, a: np.ndarray, b: np.ndarray) -> bool: 
     """The exit to the checker: FCL on what the last kernel call left of the state ``a``
     (``Exit.DECIDE_STATE``; ``b`` unused) or of the motion ``a -> b`` (``Exit.DECIDE_MOTION``);
     counts the exit. ``False`` with ``counts[Count.RAISED]`` set when the checker raised."""
-    view.counts[Count.EXITS] += 1
     copy_into(a, view.staged[0])
     copy_into(b, view.staged[1])
-    answer = call_exit(view.address, view.handle, kind, 0)
-    if answer < 0:
-        view.counts[Count.RAISED] = 1
-        return False
-    return answer == 1
+    return counted_exit(view.counts, view.address, view.handle, kind, 0) == 1
 
 
 @njit(cache=True)
