@@ -99,7 +99,7 @@ class EngineChecks:
         self.path = path
         self.exits = exits_to_python(view)
         self.steps_together = isinstance(view, ExitChecks) and view.batched
-        self.per_iteration = self.steps_together and view.per_iteration
+        self.per_iteration = isinstance(view, ExitChecks) and view.per_iteration  # (batched: exit_checks)
         self.source = source
         self.reporter = reporter  # also keeps an exit's target alive (the registry holds it weakly)
 
